@@ -1,0 +1,1 @@
+"""dolfinx finite-element baselines run beside the RKPM solvers on the same geometry."""

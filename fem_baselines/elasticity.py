@@ -1,0 +1,489 @@
+"""Plane-strain linear elasticity with dolfinx: the FEM baseline for RKPM runs.
+
+The geometry is the one the RKPM solvers use: a 2D gmsh model with one 2D
+physical group for the domain and 1D physical groups naming boundary parts.
+The model is converted with :func:`dolfinx.io.gmsh.model_to_mesh` (read on
+rank 0, distributed over ``comm``), then the problem
+
+    -div sigma(u) = f   in Omega,
+    u = g               on Gamma_D (all components or one component),
+    sigma(u) n = t      on Gamma_N,
+
+is solved with vector Lagrange P``degree`` elements on triangles and a direct
+MUMPS LU factorisation, with the plane-strain constitutive law
+``sigma = lambda tr(eps) I + 2 mu eps``,
+``lambda = E nu / ((1 + nu)(1 - 2 nu))``, ``mu = E / (2 (1 + nu))``.
+
+Units are whatever the caller uses consistently (e.g. m, Pa, N/m^3); the
+module never rescales anything.
+
+All dolfinx-specific calls of the FEM baselines live in this module (and in
+:mod:`fem_baselines.assembly_timing`). Importing it has no side effects beyond
+importing dolfinx (``dolfinx_solver`` is imported first, as it must be).
+"""
+
+from __future__ import annotations
+
+import itertools
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import dolfinx_solver  # noqa: F401  (must precede dolfinx / petsc4py: orders MPI loading)
+
+import numpy as np
+from mpi4py import MPI
+
+import dolfinx
+import dolfinx.fem
+import dolfinx.fem.petsc
+import dolfinx.geometry
+import dolfinx.io.gmsh
+import dolfinx.mesh
+import ufl
+
+__all__ = [
+    "FemElasticityResult",
+    "errors",
+    "lame_plane_strain",
+    "solve_plane_strain",
+]
+
+#: A boundary is named by a physical-group name (str), a facet-tag value
+#: (int), or a marker ``m(x) -> bool array`` with ``x`` of shape (3, npts)
+#: selecting boundary facets geometrically (see
+#: :func:`dolfinx.mesh.locate_entities_boundary`).
+BoundaryKey = str | int | Callable[[np.ndarray], np.ndarray]
+
+#: A vector field given as a callable ``g(x)``, ``x`` of shape (2, npts),
+#: returning shape (2, npts) (or (2,) for a constant), or as a constant
+#: array-like of shape (2,).
+VectorData = Callable[[np.ndarray], np.ndarray] | Any
+
+_prefix_counter = itertools.count()
+
+_MUMPS_OPTIONS = {
+    "ksp_type": "preonly",
+    "pc_type": "lu",
+    "pc_factor_mat_solver_type": "mumps",
+    "ksp_error_if_not_converged": True,
+}
+
+
+def lame_plane_strain(E: float, nu: float) -> tuple[float, float]:
+    """Lamé parameters of the plane-strain law.
+
+    Args:
+        E: Young's modulus (stress units, e.g. Pa).
+        nu: Poisson's ratio (dimensionless, -1 < nu < 0.5).
+
+    Returns:
+        ``(lam, mu)`` in the units of ``E``.
+    """
+    lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+    mu = E / (2.0 * (1.0 + nu))
+    return lam, mu
+
+
+@dataclass
+class FemElasticityResult:
+    """Solution of a plane-strain FEM baseline.
+
+    Attributes:
+        mesh: The distributed dolfinx mesh (triangles, gdim 2).
+        u: Displacement, a dolfinx vector P``degree`` Function on ``mesh``
+            (ghost values up to date).
+        n_dofs: Global number of scalar degrees of freedom (2 per node).
+        wall_time_s: Wall-clock seconds of the whole call (mesh conversion,
+            setup incl. form JIT, assembly and solve), max over ranks.
+        degree: Polynomial degree of the elements.
+        timings: Wall-clock breakdown (max over ranks) with keys ``"mesh"``
+            (gmsh -> dolfinx), ``"setup"`` (spaces, data interpolation, BCs,
+            form compilation) and ``"solve"`` (assembly, LU factorisation,
+            solve), all in seconds.
+        facet_tags: Facet MeshTags from gmsh, or None.
+        physical_groups: Physical-group name -> (dim, tag) from gmsh
+            (empty for a bare mesh).
+    """
+
+    mesh: dolfinx.mesh.Mesh
+    u: dolfinx.fem.Function
+    n_dofs: int
+    wall_time_s: float
+    degree: int = 1
+    timings: dict[str, float] = field(default_factory=dict)
+    facet_tags: Any = None
+    physical_groups: dict[str, Any] = field(default_factory=dict)
+    _tree: Any = field(default=None, init=False, repr=False)
+
+    @property
+    def comm(self) -> MPI.Comm:
+        """MPI communicator of the mesh."""
+        return self.mesh.comm
+
+    def evaluate(self, points: np.ndarray) -> np.ndarray:
+        """Evaluate the displacement at arbitrary points.
+
+        Collective: every rank must call it with the same points, and every
+        rank gets the full result. A point found in cells of several ranks
+        takes the value of the lowest such rank.
+
+        Args:
+            points: Coordinates, shape (npts, 2) (a single point of shape (2,)
+                is accepted), in mesh length units.
+
+        Returns:
+            Displacements, shape (npts, 2); rows of points lying in no cell of
+            the mesh are NaN.
+        """
+        pts = np.atleast_2d(np.asarray(points, dtype=np.float64))
+        if pts.ndim != 2 or pts.shape[1] not in (2, 3):
+            raise ValueError(f"points must have shape (npts, 2), got {np.shape(points)}")
+        npts = pts.shape[0]
+        x3 = np.zeros((npts, 3), dtype=self.mesh.geometry.x.dtype)
+        x3[:, : pts.shape[1]] = pts
+        x3[:, 2] = 0.0
+
+        tdim = self.mesh.topology.dim
+        if self._tree is None:
+            self._tree = dolfinx.geometry.bb_tree(self.mesh, tdim)
+        candidates = dolfinx.geometry.compute_collisions_points(self._tree, x3)
+        colliding = dolfinx.geometry.compute_colliding_cells(self.mesh, candidates, x3)
+        offsets = np.asarray(colliding.offsets)
+        found = np.diff(offsets) > 0
+
+        comm = self.comm
+        rank, size = comm.rank, comm.size
+        owner = np.where(found, rank, size).astype(np.int32)
+        if size > 1:
+            comm.Allreduce(MPI.IN_PLACE, owner, op=MPI.MIN)
+        mine = owner == rank
+
+        values = np.zeros((npts, 2), dtype=np.float64)
+        if np.any(mine):
+            cells = np.asarray(colliding.array)[offsets[:-1][mine]]
+            values[mine] = self.u.eval(x3[mine], cells).reshape(-1, 2)
+        if size > 1:
+            comm.Allreduce(MPI.IN_PLACE, values, op=MPI.SUM)
+        values[owner == size] = np.nan
+        return values
+
+
+def _vector_values(data: VectorData, x: np.ndarray) -> np.ndarray:
+    """Evaluate vector data at dolfinx interpolation points.
+
+    Args:
+        data: Callable of x (2, npts) or constant array-like of shape (2,).
+        x: Interpolation points from dolfinx, shape (3, npts).
+
+    Returns:
+        Array of shape (2, npts).
+    """
+    npts = x.shape[1]
+    val = np.asarray(data(x[:2]) if callable(data) else data, dtype=np.float64)
+    if val.shape == (2,):
+        val = val[:, None]
+    return np.ascontiguousarray(np.broadcast_to(val, (2, npts)))
+
+
+def _scalar_values(data: Any, x: np.ndarray) -> np.ndarray:
+    """Evaluate scalar data (callable of x (2, npts) -> (npts,), or a number).
+
+    Args:
+        data: Callable or constant.
+        x: Interpolation points from dolfinx, shape (3, npts).
+
+    Returns:
+        Array of shape (npts,).
+    """
+    npts = x.shape[1]
+    val = np.asarray(data(x[:2]) if callable(data) else data, dtype=np.float64)
+    if val.ndim == 0:
+        return np.full(npts, float(val))
+    return np.ascontiguousarray(val.reshape(npts))
+
+
+def _to_mesh_data(model_or_mesh: Any, comm: MPI.Comm):
+    """Normalise the geometry argument to (mesh, facet_tags, physical_groups)."""
+    if isinstance(model_or_mesh, dolfinx.io.gmsh.MeshData):
+        md = model_or_mesh
+        return md.mesh, md.facet_tags, dict(md.physical_groups)
+    if isinstance(model_or_mesh, dolfinx.mesh.Mesh):
+        return model_or_mesh, None, {}
+    # A gmsh model (the ``gmsh.model`` module object); only rank 0 reads it.
+    md = dolfinx.io.gmsh.model_to_mesh(model_or_mesh, comm, 0, gdim=2)
+    return md.mesh, md.facet_tags, dict(md.physical_groups)
+
+
+def _boundary_facets(
+    key: BoundaryKey,
+    mesh: dolfinx.mesh.Mesh,
+    facet_tags: Any,
+    physical_groups: Mapping[str, Any],
+) -> np.ndarray:
+    """Local indices of the facets of a named / tagged / marked boundary part.
+
+    Args:
+        key: Physical-group name, facet-tag value, or marker callable.
+        mesh: The dolfinx mesh.
+        facet_tags: Facet MeshTags (needed for str and int keys).
+        physical_groups: Name -> (dim, tag) (needed for str keys).
+
+    Returns:
+        Sorted unique local facet indices, int32 array of shape (nfacets,).
+    """
+    fdim = mesh.topology.dim - 1
+    if callable(key):
+        return np.asarray(dolfinx.mesh.locate_entities_boundary(mesh, fdim, key), dtype=np.int32)
+    if isinstance(key, str):
+        if key not in physical_groups:
+            raise KeyError(f"no physical group named {key!r}; have {sorted(physical_groups)}")
+        dim, tag = physical_groups[key]
+        if dim != fdim:
+            raise ValueError(f"physical group {key!r} has dimension {dim}, expected {fdim} (facets)")
+    elif isinstance(key, (int, np.integer)):
+        tag = int(key)
+    else:
+        raise TypeError(f"boundary key must be str, int or callable, got {type(key).__name__}")
+    if facet_tags is None:
+        raise ValueError(f"boundary {key!r} given by name/tag but the mesh has no facet tags")
+    return np.asarray(facet_tags.find(int(tag)), dtype=np.int32)
+
+
+def solve_plane_strain(
+    model_or_mesh: Any,
+    E: float,
+    nu: float,
+    dirichlet: Mapping[BoundaryKey, Any],
+    tractions: Mapping[BoundaryKey, VectorData] | None = None,
+    body_force: VectorData | None = None,
+    degree: int = 1,
+    comm: MPI.Comm | None = None,
+) -> FemElasticityResult:
+    """Solve plane-strain linear elasticity with vector Lagrange elements.
+
+    Collective on ``comm``.
+
+    Args:
+        model_or_mesh: The geometry: the ``gmsh.model`` module object of a
+            model already meshed in 2D (triangles) with one 2D physical group
+            for the domain and 1D physical groups naming boundary parts (only
+            rank 0 needs the model; it is distributed over ``comm``); or a
+            :class:`dolfinx.io.gmsh.MeshData` already converted; or a bare
+            :class:`dolfinx.mesh.Mesh` (boundaries then given by marker
+            callables).
+        E: Young's modulus (stress units, e.g. Pa).
+        nu: Poisson's ratio (dimensionless, < 0.5).
+        dirichlet: Boundary -> prescribed displacement. The key is a
+            physical-group name (str), a facet-tag value (int) or a marker
+            ``m(x) -> bool (npts,)`` with x of shape (3, npts). The value is
+            either ``g`` -- a callable ``g(x)``, x of shape (2, npts), returning
+            both components, shape (2, npts) (or a constant of shape (2,)) --
+            or a tuple ``(component, g)`` fixing only that component
+            (0 = x, 1 = y; a roller), ``g(x)`` returning shape (npts,) (or a
+            number). Length units.
+        tractions: Boundary -> surface traction ``t(x)``, x of shape
+            (2, npts), returning shape (2, npts) (or a constant of shape (2,)),
+            in stress units. Boundaries given here must be disjoint. None for
+            no tractions (traction-free where no Dirichlet data is given).
+        body_force: Body force per unit volume ``f(x)``, x of shape (2, npts),
+            returning shape (2, npts) (or a constant of shape (2,)), e.g. N/m^3.
+            None for no body force.
+        degree: Polynomial degree of the displacement elements (>= 1).
+        comm: MPI communicator; defaults to ``MPI.COMM_WORLD``. Ignored for
+            an already-built mesh (its communicator is used).
+
+    Returns:
+        The solution; see :class:`FemElasticityResult`.
+
+    Note:
+        Traction and body-force callables are interpolated into a vector
+        Lagrange space of degree ``degree + 1`` (so that data interpolation
+        does not limit the convergence rate); Dirichlet data is interpolated
+        into the solution space. E and nu enter the forms as dolfinx
+        Constants, so changing them does not trigger a new form compilation.
+    """
+    if degree < 1:
+        raise ValueError(f"degree must be >= 1, got {degree}")
+    comm = MPI.COMM_WORLD if comm is None else comm
+    t_start = time.perf_counter()
+
+    mesh, facet_tags, physical_groups = _to_mesh_data(model_or_mesh, comm)
+    comm = mesh.comm
+    if mesh.geometry.dim != 2 or mesh.topology.cell_type != dolfinx.mesh.CellType.triangle:
+        raise ValueError("solve_plane_strain expects a 2D triangle mesh (gdim 2)")
+    tdim = mesh.topology.dim
+    fdim = tdim - 1
+    mesh.topology.create_connectivity(fdim, tdim)
+    t_mesh = time.perf_counter()
+
+    V = dolfinx.fem.functionspace(mesh, ("Lagrange", degree, (2,)))
+    W = dolfinx.fem.functionspace(mesh, ("Lagrange", degree + 1, (2,)))
+    scalar = dolfinx.default_scalar_type
+
+    # Dirichlet conditions.
+    bcs = []
+    for key, spec in dirichlet.items():
+        facets = _boundary_facets(key, mesh, facet_tags, physical_groups)
+        if isinstance(spec, tuple):
+            comp, g = spec
+            comp = int(comp)
+            if comp not in (0, 1):
+                raise ValueError(f"Dirichlet component must be 0 or 1, got {comp}")
+            Vc, _ = V.sub(comp).collapse()
+            gc = dolfinx.fem.Function(Vc)
+            gc.interpolate(lambda x, g=g: _scalar_values(g, x))
+            dofs = dolfinx.fem.locate_dofs_topological((V.sub(comp), Vc), fdim, facets)
+            bcs.append(dolfinx.fem.dirichletbc(gc, dofs, V.sub(comp)))
+        else:
+            gv = dolfinx.fem.Function(V)
+            gv.interpolate(lambda x, g=spec: _vector_values(g, x))
+            dofs = dolfinx.fem.locate_dofs_topological(V, fdim, facets)
+            bcs.append(dolfinx.fem.dirichletbc(gv, dofs))
+
+    # Constitutive law (Constants: no recompilation for new E, nu).
+    lam_v, mu_v = lame_plane_strain(E, nu)
+    lam = dolfinx.fem.Constant(mesh, scalar(lam_v))
+    mu = dolfinx.fem.Constant(mesh, scalar(mu_v))
+
+    def eps(w):
+        return ufl.sym(ufl.grad(w))
+
+    def sigma(w):
+        return lam * ufl.tr(eps(w)) * ufl.Identity(2) + 2.0 * mu * eps(w)
+
+    u = ufl.TrialFunction(V)
+    v = ufl.TestFunction(V)
+    a = ufl.inner(sigma(u), eps(v)) * ufl.dx
+
+    rhs = []
+    if body_force is not None:
+        f = dolfinx.fem.Function(W, name="body_force")
+        f.interpolate(lambda x: _vector_values(body_force, x))
+        rhs.append(ufl.inner(f, v) * ufl.dx)
+    if tractions:
+        parts = [_boundary_facets(k, mesh, facet_tags, physical_groups) for k in tractions]
+        all_facets = np.concatenate(parts)
+        values = np.concatenate([np.full(p.size, i + 1, dtype=np.int32) for i, p in enumerate(parts)])
+        order = np.argsort(all_facets, kind="stable")
+        all_facets, values = all_facets[order], values[order]
+        if np.any(np.diff(all_facets) == 0):
+            raise ValueError("traction boundaries overlap; give each facet one traction")
+        traction_tags = dolfinx.mesh.meshtags(mesh, fdim, all_facets, values)
+        ds = ufl.Measure("ds", domain=mesh, subdomain_data=traction_tags)
+        for i, t_data in enumerate(tractions.values()):
+            t = dolfinx.fem.Function(W, name=f"traction_{i}")
+            t.interpolate(lambda x, t_data=t_data: _vector_values(t_data, x))
+            rhs.append(ufl.inner(t, v) * ds(i + 1))
+    if rhs:
+        L = sum(rhs[1:], rhs[0])
+    else:
+        L = ufl.inner(dolfinx.fem.Constant(mesh, np.zeros(2, dtype=scalar)), v) * ufl.dx
+
+    uh = dolfinx.fem.Function(V, name="u")
+    problem = dolfinx.fem.petsc.LinearProblem(
+        a,
+        L,
+        bcs=bcs,
+        u=uh,
+        petsc_options_prefix=f"rkfx_fem_elasticity_{next(_prefix_counter)}_",
+        petsc_options=dict(_MUMPS_OPTIONS),
+    )
+    t_setup = time.perf_counter()
+    problem.solve()
+    reason = problem.solver.getConvergedReason()
+    if reason <= 0:
+        raise RuntimeError(f"linear solve failed (KSP reason {reason})")
+    del problem
+    t_end = time.perf_counter()
+
+    local = np.array([t_mesh - t_start, t_setup - t_mesh, t_end - t_setup, t_end - t_start])
+    glob = np.empty_like(local)
+    comm.Allreduce(local, glob, op=MPI.MAX)
+    imap = V.dofmap.index_map
+    return FemElasticityResult(
+        mesh=mesh,
+        u=uh,
+        n_dofs=int(imap.size_global * V.dofmap.index_map_bs),
+        wall_time_s=float(glob[3]),
+        degree=degree,
+        timings={"mesh": float(glob[0]), "setup": float(glob[1]), "solve": float(glob[2])},
+        facet_tags=facet_tags,
+        physical_groups=physical_groups,
+    )
+
+
+def _max_cell_diameter(mesh: dolfinx.mesh.Mesh) -> float:
+    """Largest edge length over owned cells (vertex-based), global max."""
+    ncells = mesh.topology.index_map(mesh.topology.dim).size_local
+    x = mesh.geometry.x[:, :2]
+    conn = mesh.geometry.dofmaps[0][:ncells, :3]
+    h = 0.0
+    if ncells:
+        p = x[conn]  # (ncells, 3, 2)
+        edges = p - np.roll(p, 1, axis=1)
+        h = float(np.sqrt((edges**2).sum(axis=2)).max())
+    return mesh.comm.allreduce(h, op=MPI.MAX)
+
+
+def errors(
+    result: FemElasticityResult,
+    u_exact: Callable[[Any], Any],
+    grad_exact: Callable[[Any], Any] | None = None,
+) -> dict[str, float]:
+    """Relative L2 and H1-seminorm errors against an exact solution.
+
+    Collective on the mesh communicator. Integrals use quadrature degree
+    ``result.degree + 3``.
+
+    Args:
+        result: A solution from :func:`solve_plane_strain`.
+        u_exact: ``u_exact(X)`` takes ``X = ufl.SpatialCoordinate(mesh)`` and
+            returns a UFL vector expression of shape (2,) (a list/tuple of two
+            UFL scalars is accepted), e.g.
+            ``lambda X: ufl.as_vector((ufl.sin(ufl.pi * X[0]), X[1]))``.
+        grad_exact: ``grad_exact(X)`` returns the 2x2 UFL displacement
+            gradient, ``G[i, j] = d u_i / d x_j`` (nested lists accepted). If
+            None, ``ufl.grad(u_exact(X))`` is used.
+
+    Returns:
+        Dict with ``"l2"`` = ||u_h - u|| / ||u||, ``"h1"`` =
+        |u_h - u|_1 / |u|_1 (relative, dimensionless), the absolute values
+        ``"l2_abs"`` (length * length units) and ``"h1_abs"``, the exact
+        norms ``"l2_norm"``, ``"h1_norm"``, and ``"h_max"`` (largest cell edge).
+    """
+    mesh, uh = result.mesh, result.u
+    X = ufl.SpatialCoordinate(mesh)
+    ue = u_exact(X)
+    if isinstance(ue, (list, tuple)):
+        ue = ufl.as_vector(ue)
+    if grad_exact is None:
+        Ge = ufl.grad(ue)
+    else:
+        Ge = grad_exact(X)
+        if isinstance(Ge, (list, tuple)):
+            Ge = ufl.as_matrix(Ge)
+    dx = ufl.Measure("dx", domain=mesh, metadata={"quadrature_degree": result.degree + 3})
+    eu = uh - ue
+    eg = ufl.grad(uh) - Ge
+    integrands = [
+        ufl.inner(eu, eu) * dx,
+        ufl.inner(ue, ue) * dx,
+        ufl.inner(eg, eg) * dx,
+        ufl.inner(Ge, Ge) * dx,
+    ]
+    vals = [
+        mesh.comm.allreduce(dolfinx.fem.assemble_scalar(dolfinx.fem.form(F)), op=MPI.SUM)
+        for F in integrands
+    ]
+    e_l2, n_l2, e_h1, n_h1 = (float(np.sqrt(max(val, 0.0))) for val in vals)
+    return {
+        "l2": e_l2 / n_l2 if n_l2 > 0 else float("nan"),
+        "h1": e_h1 / n_h1 if n_h1 > 0 else float("nan"),
+        "l2_abs": e_l2,
+        "h1_abs": e_h1,
+        "l2_norm": n_l2,
+        "h1_norm": n_h1,
+        "h_max": _max_cell_diameter(mesh),
+    }

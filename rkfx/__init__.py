@@ -1,0 +1,18 @@
+"""rkfx: reproducing kernel particle methods for geomechanics.
+
+The numerical core (this package's top-level modules) needs only numpy, scipy and numba:
+
+    particles        nodes, spacing, background triangulation, named boundaries
+    gmsh_nodes       particles from gmsh models and .geo files (needs gmsh)
+    nodal_domains    conforming median-dual cells, subcells, boundary segments
+    shape_functions  RK shape functions and direct gradients (eqs. 3.17-3.25)
+    quadrature       Gauss, DNI, SCNI and MSCNI rules as sparse rows (eqs. 3.55-3.56)
+    operators        B^T D B w products: stiffness, diffusion, mass, loads
+    boundary         boundary integration and essential conditions
+    elasticity       material laws
+    elastostatics    plane-strain solver
+
+``rkfx.petsc`` (imported on purpose) hands the sparse operators to PETSc; ``rkfx.cases``
+holds the runnable benchmarks (``python -m rkfx.cases.<name>``).
+"""
+__version__ = "0.1.0"

@@ -1,0 +1,103 @@
+"""Plane-strain elastostatics with RK shape functions: assemble, constrain, solve through PETSc."""
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from .boundary import (BC_METHODS, Dirichlet, Traction, boundary_quadrature, nitsche_terms, traction_load,
+                       transformation_constraints)
+from .elasticity import ElasticMaterial
+from .errors import InputError
+from .nodal_domains import nodal_domains
+from .operators import load_vector, stiffness
+from .particles import Particles
+from .quadrature import integration_rules
+from .shape_functions import RKApproximation, evaluate, rk_approximation
+
+
+@dataclass(frozen=True)
+class ElasticSolution:
+    """RK coefficients of the displacement and what is needed to evaluate it.
+
+    Attributes:
+        rk: The approximation.
+        coefficients: Nodal coefficients d_I (not nodal values), shape ``(num_nodes, 2)`` [m].
+        n_dofs: Number of displacement unknowns.
+        timings: Wall times of the stages [s].
+    """
+
+    rk: RKApproximation
+    coefficients: np.ndarray
+    n_dofs: int
+    timings: dict[str, float] = field(default_factory=dict)
+
+    def displacement(self, points: np.ndarray) -> np.ndarray:
+        """u^h at points, shape ``(m, 2)`` [m]."""
+        return evaluate(self.rk, points).matrix(0) @ self.coefficients
+
+    def gradient(self, points: np.ndarray) -> np.ndarray:
+        """Direct gradient of u^h at points, shape ``(m, 2, 2)`` with [i, j] = du_i/dx_j."""
+        rows = evaluate(self.rk, points, gradients=True)
+        return np.stack([rows.matrix(1) @ self.coefficients, rows.matrix(2) @ self.coefficients], axis=2)
+
+
+def solve_plane_strain(p: Particles, material: ElasticMaterial, dirichlet: Sequence[Dirichlet],
+                       tractions: Sequence[Traction] = (),
+                       body_force: Callable[[np.ndarray], np.ndarray] | None = None,
+                       rule: str = "mscni", bc_method: str = "transformation", support_factor: float = 1.5,
+                       order: int = 1, nitsche_penalty: float = 100.0, comm=None,
+                       solver: str = "mumps") -> ElasticSolution:
+    """Solve plane-strain elasticity on ``p``.
+
+    Args:
+        p: Particles with named boundary parts.
+        material: Elastic constants.
+        dirichlet: Prescribed displacements.
+        tractions: Prescribed tractions.
+        body_force: b(x) [N/m^3] for x of shape ``(m, 2)``, returning ``(m, 2)``.
+        rule: Integration rule: ``gauss1|gauss2|gauss4|dni|scni|mscni``.
+        bc_method: ``transformation`` or ``nitsche``.
+        support_factor, order: RK support a_I = c h_I and basis degree.
+        nitsche_penalty: Dimensionless Nitsche parameter.
+        comm: MPI communicator for the PETSc solve (default COMM_WORLD).
+        solver: ``mumps`` | ``gmres-ilu`` | ``cg-gamg``.
+    """
+    if bc_method not in BC_METHODS:
+        raise InputError(f"unknown bc_method {bc_method!r}; choose one of {', '.join(BC_METHODS)}")
+    times = {}
+    t0 = time.perf_counter()
+    rk = rk_approximation(p.x, p.spacing, support_factor, order)
+    domains = nodal_domains(p)
+    quads = integration_rules(rule, p, rk, domains)
+    d = material.D()
+    k = stiffness(quads, d)
+    bq = boundary_quadrature(p, domains, rk)
+    f = traction_load(p, bq, tractions)
+    if body_force is not None:
+        q = quads[0]
+        f += load_vector(q.values, q.weights, body_force(q.points))
+    times["assemble"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    if bc_method == "nitsche":
+        kn, fn = nitsche_terms(p, bq, d, dirichlet, nitsche_penalty)
+        system, rhs = k + kn, f + fn
+    else:
+        g, gv = transformation_constraints(p, rk, dirichlet)
+        system = sp.bmat([[k, g.T], [g, None]], format="csr")
+        rhs = np.concatenate([f, gv])
+    x = _linear_solve(system, rhs, comm, solver)
+    times["solve"] = time.perf_counter() - t0
+    return ElasticSolution(rk, x[:2 * p.num_nodes].reshape(-1, 2), 2 * p.num_nodes, times)
+
+
+def _linear_solve(a, b, comm, solver):
+    try:
+        from . import petsc  # noqa: PLC0415
+    except ImportError:
+        if solver != "mumps":
+            raise InputError(f"solver {solver!r} needs PETSc: pip install 'rkfx[fem]'") from None
+        import scipy.sparse.linalg as spla  # noqa: PLC0415
+        return spla.spsolve(a.tocsc(), b)
+    return petsc.solve(a, b, comm if comm is not None else petsc.MPI.COMM_WORLD, solver)

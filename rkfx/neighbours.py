@@ -1,0 +1,136 @@
+"""Neighbour search: which nodes' supports cover each evaluation point.
+
+A uniform cell list (``CellGrid``) with cell size equal to the largest support radius; a
+point visits the 3 x 3 block of cells around it. Compiled loops run in parallel over
+chunks of points, so the cost is O(N) for node sets of bounded grading.
+"""
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+CHUNK = 2048  # points per parallel work item
+
+
+@dataclass(frozen=True)
+class CellGrid:
+    """Nodes binned into square cells; cell c holds ``order[start[c]:start[c + 1]]``."""
+
+    origin: np.ndarray  # (2,) lower-left corner [m]
+    cell: float  # cell size [m]
+    shape: tuple[int, int]  # (nx, ny)
+    start: np.ndarray  # (nx * ny + 1,) int64
+    order: np.ndarray  # (num_nodes,) int64
+
+
+@numba.njit(cache=True)
+def _bin_nodes(x, origin, cell, nx, ny):
+    n = x.shape[0]
+    cell_of = np.empty(n, np.int64)
+    for i in range(n):
+        cx = min(max(int((x[i, 0] - origin[0]) / cell), 0), nx - 1)
+        cy = min(max(int((x[i, 1] - origin[1]) / cell), 0), ny - 1)
+        cell_of[i] = cy * nx + cx
+    start = np.zeros(nx * ny + 1, np.int64)
+    for i in range(n):
+        start[cell_of[i] + 1] += 1
+    for c in range(nx * ny):
+        start[c + 1] += start[c]
+    fill = start[:-1].copy()
+    order = np.empty(n, np.int64)
+    for i in range(n):
+        order[fill[cell_of[i]]] = i
+        fill[cell_of[i]] += 1
+    return start, order
+
+
+def cell_grid(x: np.ndarray, a: np.ndarray, points: np.ndarray) -> CellGrid:
+    """Bin nodes ``x`` (shape ``(num_nodes, 2)``) with support radii ``a`` for queries at ``points``."""
+    lo = x.min(axis=0)
+    hi = x.max(axis=0)
+    if len(points):
+        lo = np.minimum(lo, points.min(axis=0))
+        hi = np.maximum(hi, points.max(axis=0))
+    cell = float(a.max())
+    extent = np.maximum(hi - lo, cell)
+    # Cap the grid at ~4 cells per node so sparse clouds in large boxes stay cheap.
+    cell = max(cell, float(np.sqrt(extent[0] * extent[1] / (4.0 * len(x)))))
+    nx, ny = (int(e / cell) + 1 for e in extent)
+    start, order = _bin_nodes(x, lo, cell, nx, ny)
+    return CellGrid(lo, cell, (nx, ny), start, order)
+
+
+@numba.njit(inline="always")
+def cell_range(px, py, origin, cell, nx, ny):
+    """Index bounds of the 3 x 3 cell block around a point."""
+    cx = int((px - origin[0]) / cell)
+    cy = int((py - origin[1]) / cell)
+    return max(cx - 1, 0), min(cx + 2, nx), max(cy - 1, 0), min(cy + 2, ny)
+
+
+@numba.njit(parallel=True, cache=True)
+def count_covering(x, a, points, origin, cell, nx, ny, start, order):
+    """Number of nodes J with |p - x_J| < a_J for each point p."""
+    m = points.shape[0]
+    counts = np.zeros(m, np.int64)
+    for c in numba.prange((m + CHUNK - 1) // CHUNK):
+        for p in range(c * CHUNK, min(m, (c + 1) * CHUNK)):
+            px = points[p, 0]
+            py = points[p, 1]
+            x0, x1, y0, y1 = cell_range(px, py, origin, cell, nx, ny)
+            k = 0
+            for jy in range(y0, y1):
+                for jx in range(x0, x1):
+                    cc = jy * nx + jx
+                    for q in range(start[cc], start[cc + 1]):
+                        j = order[q]
+                        dx = px - x[j, 0]
+                        dy = py - x[j, 1]
+                        if dx * dx + dy * dy < a[j] * a[j]:
+                            k += 1
+            counts[p] = k
+    return counts
+
+
+@numba.njit(parallel=True, cache=True)
+def _fill(x, a, points, origin, cell, nx, ny, start, order, indptr, indices):
+    m = points.shape[0]
+    for c in numba.prange((m + CHUNK - 1) // CHUNK):
+        for p in range(c * CHUNK, min(m, (c + 1) * CHUNK)):
+            px = points[p, 0]
+            py = points[p, 1]
+            x0, x1, y0, y1 = cell_range(px, py, origin, cell, nx, ny)
+            k = indptr[p]
+            for jy in range(y0, y1):
+                for jx in range(x0, x1):
+                    cc = jy * nx + jx
+                    for q in range(start[cc], start[cc + 1]):
+                        j = order[q]
+                        dx = px - x[j, 0]
+                        dy = py - x[j, 1]
+                        if dx * dx + dy * dy < a[j] * a[j]:
+                            indices[k] = j
+                            k += 1
+
+
+def support_neighbours(x: np.ndarray, a: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes J with |p - x_J| < a_J for every point p.
+
+    Args:
+        x: Node coordinates, shape ``(num_nodes, 2)`` [m].
+        a: Support radii, shape ``(num_nodes,)`` [m].
+        points: Evaluation points, shape ``(num_points, 2)`` [m].
+
+    Returns:
+        ``(indptr, indices)``: CSR rows, shapes ``(num_points + 1,)`` int64 and ``(nnz,)`` int32.
+    """
+    x = np.ascontiguousarray(x, dtype=np.float64)
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
+    g = cell_grid(x, a, points)
+    counts = count_covering(x, a, points, g.origin, g.cell, *g.shape, g.start, g.order)
+    indptr = np.zeros(len(points) + 1, np.int64)
+    np.cumsum(counts, out=indptr[1:])
+    indices = np.empty(indptr[-1], np.int32)
+    _fill(x, a, points, g.origin, g.cell, *g.shape, g.start, g.order, indptr, indices)
+    return indptr, indices

@@ -1,0 +1,75 @@
+"""Sparse operators as ``B^T D B w`` products over quadratures.
+
+Degrees of freedom of vector fields are interleaved per node: (u_x0, u_y0, u_x1, ...).
+Strains use Voigt order (eps_xx, eps_yy, gamma_xy).
+"""
+import numpy as np
+import scipy.sparse as sp
+
+from .quadrature import Quadrature
+from .sparse_rows import SparseRows
+
+
+def strain_matrix(grad: SparseRows) -> sp.csr_matrix:
+    """B with rows (eps_xx, eps_yy, gamma_xy) per point, shape ``(3 m, 2 n)``."""
+    m, n = grad.num_rows, grad.num_cols
+    row = np.repeat(np.arange(m), np.diff(grad.indptr))
+    gx, gy = grad.data[:, 0], grad.data[:, 1]
+    col = 2 * grad.indices.astype(np.int64)
+    rows = np.concatenate([3 * row, 3 * row + 1, 3 * row + 2, 3 * row + 2])
+    cols = np.concatenate([col, col + 1, col, col + 1])
+    vals = np.concatenate([gx, gy, gy, gx])
+    return sp.csr_matrix((vals, (rows, cols)), shape=(3 * m, 2 * n))
+
+
+def weighted_product(b: sp.csr_matrix, weights: np.ndarray, d: np.ndarray) -> sp.csr_matrix:
+    """``B^T diag_q(w_q D) B`` for a point-wise constant ``d`` of shape ``(k, k)`` (or ``(m, k, k)``)."""
+    k = b.shape[0] // len(weights)
+    d = np.broadcast_to(d, (len(weights), k, k))
+    return (b.T @ _block_diagonal(weights[:, None, None] * d) @ b).tocsr()
+
+
+def _block_diagonal(blocks: np.ndarray) -> sp.csr_matrix:
+    m, k, _ = blocks.shape
+    base = k * np.arange(m)
+    rows = np.broadcast_to(base[:, None, None] + np.arange(k)[None, :, None], blocks.shape)
+    cols = np.broadcast_to(base[:, None, None] + np.arange(k)[None, None, :], blocks.shape)
+    return sp.csr_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())), shape=(m * k, m * k))
+
+
+def stiffness(quadratures: list[Quadrature], d: np.ndarray) -> sp.csr_matrix:
+    """Elastic stiffness ``sum_q w_q B_q^T D B_q`` (eqs. 3.32 and 3.56), shape ``(2 n, 2 n)``."""
+    return sum(weighted_product(strain_matrix(q.gradients), q.weights, d) for q in quadratures)
+
+
+def laplacian(quadratures: list[Quadrature], k: np.ndarray | float = 1.0) -> sp.csr_matrix:
+    """Diffusion matrix ``sum_q w_q (grad N)^T k grad N`` (eqs. 3.35 and 3.59), shape ``(n, n)``."""
+    total = None
+    for q in quadratures:
+        g = q.gradients
+        gx, gy = g.matrix(0), g.matrix(1)
+        kk = np.broadcast_to(np.asarray(k, float) * np.eye(2) if np.ndim(k) == 0 else k, (2, 2))
+        w = sp.diags(q.weights)
+        term = (kk[0, 0] * gx.T @ w @ gx + kk[0, 1] * gx.T @ w @ gy + kk[1, 0] * gy.T @ w @ gx
+                + kk[1, 1] * gy.T @ w @ gy)
+        total = term if total is None else total + term
+    return total.tocsr()
+
+
+def mass(quadratures: list[Quadrature], c: float = 1.0) -> sp.csr_matrix:
+    """``sum_q w_q c N^T N`` over the value rows (eqs. 3.34 and 3.58), shape ``(n, n)``."""
+    total = None
+    for q in quadratures:
+        if q.values is None:
+            continue
+        nmat = q.values.matrix()
+        term = nmat.T @ sp.diags(c * q.weights) @ nmat
+        total = term if total is None else total + term
+    return total.tocsr()
+
+
+def load_vector(values: SparseRows, weights: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """``sum_q w_q N_I(x_q) f(x_q)`` for point data ``f`` of shape ``(m,)`` or ``(m, k)``; interleaved."""
+    f = np.asarray(f, float)
+    out = values.matrix().T @ (weights[:, None] * f.reshape(len(weights), -1))
+    return out.ravel()

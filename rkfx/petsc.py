@@ -1,0 +1,110 @@
+"""PETSc glue: scipy CSR -> distributed ``PETSc.Mat``, vectors, and KSP solves.
+
+Import on purpose (``import rkfx.petsc``); the numerical core never imports PETSc. Every
+function takes an MPI communicator. Matrices are distributed by contiguous row blocks
+(PETSc's default ownership); each rank inserts only the rows it owns from the CSR data it
+holds, so the same code runs serially and under ``mpiexec -n P``.
+"""
+import dolfinx_solver  # noqa: F401  (orders MPI before petsc4py)
+import numpy as np
+import scipy.sparse as sp
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from .errors import InputError
+
+SOLVERS = ("mumps", "gmres-ilu", "cg-gamg")
+
+
+class SolverDiverged(RuntimeError):
+    """A PETSc linear solve did not converge."""
+
+
+def to_petsc_mat(a: sp.spmatrix, comm=MPI.COMM_WORLD) -> PETSc.Mat:
+    """Distributed AIJ matrix from a global scipy sparse matrix held on every rank."""
+    a = sp.csr_matrix(a)
+    a.sort_indices()
+    n_rows, n_cols = a.shape
+    mat = PETSc.Mat().create(comm=comm)
+    mat.setSizes(((PETSc.DECIDE, n_rows), (PETSc.DECIDE, n_cols)))
+    mat.setType(PETSc.Mat.Type.AIJ)
+    mat.setUp()
+    lo, hi = mat.getOwnershipRange()
+    ptr = a.indptr[lo:hi + 1]
+    local_ptr = (ptr - ptr[0]).astype(PETSc.IntType)
+    cols = a.indices[ptr[0]:ptr[-1]].astype(PETSc.IntType)
+    vals = a.data[ptr[0]:ptr[-1]].astype(PETSc.ScalarType)
+    mat.setPreallocationCSR((local_ptr, cols, vals))
+    mat.assemble()
+    return mat
+
+
+def to_petsc_vec(v: np.ndarray, mat: PETSc.Mat) -> PETSc.Vec:
+    """Vector with the row layout of ``mat``, from a global array held on every rank."""
+    vec = mat.createVecLeft()
+    lo, hi = vec.getOwnershipRange()
+    vec.array[:] = np.asarray(v, dtype=PETSc.ScalarType)[lo:hi]
+    return vec
+
+
+def gather(vec: PETSc.Vec) -> np.ndarray:
+    """The whole vector on every rank."""
+    comm = vec.getComm().tompi4py()
+    return np.concatenate(comm.allgather(vec.array_r.copy()))
+
+
+def make_ksp(mat: PETSc.Mat, solver: str = "mumps", rtol: float = 1e-12, prefix: str = "rkfx_") -> PETSc.KSP:
+    """A KSP for ``mat``: MUMPS LU (default), GMRES with ILU/ASM, or CG with GAMG.
+
+    PETSc options given with ``-rkfx_...`` on the command line refine the choice.
+    """
+    if solver not in SOLVERS:
+        raise InputError(f"unknown linear solver {solver!r}; choose one of {', '.join(SOLVERS)}")
+    ksp = PETSc.KSP().create(mat.getComm())
+    ksp.setOperators(mat)
+    ksp.setOptionsPrefix(prefix)
+    pc = ksp.getPC()
+    if solver == "mumps":
+        ksp.setType("preonly")
+        pc.setType("lu")
+        pc.setFactorSolverType("mumps")
+        pc.setFactorSetUpSolverType()
+        # Saddle-point systems (multiplier constraints, u-p coupling) delay pivots: give MUMPS
+        # room for them (ICNTL(14): % extra workspace) instead of failing with INFOG(1) = -9.
+        pc.getFactorMatrix().setMumpsIcntl(14, 200)
+    elif solver == "gmres-ilu":
+        ksp.setType("gmres")
+        pc.setType("asm" if mat.getComm().size > 1 else "ilu")
+        ksp.setTolerances(rtol=rtol, max_it=10000)
+    else:
+        ksp.setType("cg")
+        pc.setType("gamg")
+        ksp.setTolerances(rtol=rtol, max_it=10000)
+    ksp.setFromOptions()
+    return ksp
+
+
+def solve(a: sp.spmatrix, b: np.ndarray, comm=MPI.COMM_WORLD, solver: str = "mumps") -> np.ndarray:
+    """Solve ``a x = b`` through PETSc; returns the whole solution on every rank.
+
+    Raises:
+        SolverDiverged: Naming PETSc's reason and what to try instead.
+    """
+    mat = to_petsc_mat(a, comm)
+    rhs = to_petsc_vec(b, mat)
+    x = mat.createVecRight()
+    ksp = make_ksp(mat, solver)
+    try:
+        ksp.solve(rhs, x)
+    except PETSc.Error as err:
+        raise SolverDiverged(f"PETSc solver {solver!r} failed ({err}); the system may be singular: "
+                             "check that essential boundary conditions remove all rigid-body modes") from None
+    reason = ksp.getConvergedReason()
+    if reason < 0:
+        raise SolverDiverged(f"PETSc solver {solver!r} diverged (KSPConvergedReason {reason}) after "
+                             f"{ksp.getIterationNumber()} iterations; try solver='mumps' or check the "
+                             "boundary conditions")
+    out = gather(x)
+    for obj in (ksp, mat, rhs, x):
+        obj.destroy()
+    return out

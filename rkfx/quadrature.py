@@ -1,0 +1,155 @@
+"""Domain integration rules, all producing ``Quadrature``: points, weights and shape rows.
+
+* ``gauss``  — Gauss points on the background triangles, direct gradients.
+* ``dni``    — direct nodal integration: nodes, weights A_L, direct gradients.
+* ``scni``   — stabilized conforming nodal integration: nodes, weights A_L, gradients
+  smoothed over Omega_L by the divergence theorem (eq. 3.55).
+* ``mscni``  — SCNI plus the subcell stabilization of eq. (3.56): extra "points" whose rows
+  are the differences grad~N_I(x_L) - grad~N_I(x_hat_C) with weights eps_p A_C.
+
+A bilinear form int B^T D B dOmega is then ``sum over rules and points of w B^T D B``, the
+same code for elasticity, Darcy flow and coupling (``rkfx.operators``).
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import InputError
+from .nodal_domains import NodalDomains
+from .particles import Particles
+from .shape_functions import RKApproximation, evaluate
+from .sparse_rows import SparseRows, combine_rows, stack_rows
+
+# Symmetric Gauss rules on the reference triangle: barycentric points and weights (sum 1).
+_TRIANGLE_RULES = {
+    1: (np.array([[1 / 3, 1 / 3, 1 / 3]]), np.array([1.0])),
+    2: (np.array([[2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]]), np.full(3, 1 / 3)),
+    4: (np.array([[0.108103018168070, 0.445948490915965, 0.445948490915965],
+                  [0.445948490915965, 0.108103018168070, 0.445948490915965],
+                  [0.445948490915965, 0.445948490915965, 0.108103018168070],
+                  [0.816847572980459, 0.091576213509771, 0.091576213509771],
+                  [0.091576213509771, 0.816847572980459, 0.091576213509771],
+                  [0.091576213509771, 0.091576213509771, 0.816847572980459]]),
+        np.array([0.223381589678011] * 3 + [0.109951743655322] * 3)),
+}
+
+
+@dataclass(frozen=True)
+class Quadrature:
+    """Integration points of one rule with the shape rows a bilinear form needs.
+
+    Attributes:
+        points: Shape ``(num_points, 2)`` [m] (for stabilization rows: the subcell centroids).
+        weights: Shape ``(num_points,)`` [m^2].
+        values: Rows with entries [N_I], or ``None`` where a rule has no value part.
+        gradients: Rows with entries [N_I,x, N_I,y] [1/m] (direct or smoothed).
+        name: Rule name, for reports.
+    """
+
+    points: np.ndarray
+    weights: np.ndarray
+    values: SparseRows | None
+    gradients: SparseRows
+    name: str
+
+
+def gauss(p: Particles, rk: RKApproximation, degree: int = 2) -> Quadrature:
+    """Gauss quadrature on the triangles, exact for polynomials of ``degree`` (1, 2 or 4)."""
+    if degree not in _TRIANGLE_RULES:
+        raise InputError(f"Gauss degree {degree!r} not available; use one of {sorted(_TRIANGLE_RULES)}")
+    bary, w = _TRIANGLE_RULES[degree]
+    xt = p.x[p.triangles]
+    e1, e2 = xt[:, 1] - xt[:, 0], xt[:, 2] - xt[:, 0]
+    area = 0.5 * (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    pts = np.einsum("qk,tkd->tqd", bary, xt).reshape(-1, 2)
+    rows = evaluate(rk, pts, gradients=True)
+    return Quadrature(pts, np.outer(area, w).ravel(), rows.component(0),
+                      SparseRows(rows.indptr, rows.indices, rows.data[:, 1:], rows.num_cols), f"gauss{degree}")
+
+
+def dni(p: Particles, rk: RKApproximation, domains: NodalDomains) -> Quadrature:
+    """Direct nodal integration: N and its direct gradient at the nodes, weights A_L."""
+    rows = evaluate(rk, p.x, gradients=True)
+    return Quadrature(p.x, domains.area, rows.component(0),
+                      SparseRows(rows.indptr, rows.indices, rows.data[:, 1:], rows.num_cols), "dni")
+
+
+@dataclass(frozen=True)
+class SmoothedGradients:
+    """Smoothed gradients of all shape functions on every nodal cell and subcell (eq. 3.55).
+
+    Attributes:
+        cell: Rows per node L: grad~N_I(x_L) [1/m].
+        subcell: Rows per subcell C: grad~N_I(x_hat_C), smoothed over C [1/m].
+        node_values: Rows per node L: N_I(x_L).
+    """
+
+    cell: SparseRows
+    subcell: SparseRows
+    node_values: SparseRows
+
+
+def smoothed_gradients(p: Particles, rk: RKApproximation, domains: NodalDomains,
+                       subcells: bool = True) -> SmoothedGradients:
+    """N at the smoothing points, combined into cell (and subcell) smoothed gradients."""
+    d = domains
+    at_points = evaluate(rk, d.smoothing_points)
+    cell = combine_rows(at_points, d.cell_ptr, d.cell_point,
+                        d.cell_normal_length / np.repeat(d.area, np.diff(d.cell_ptr))[:, None])
+    sub = None
+    if subcells:
+        ns = len(d.subcell_area)
+        sub = combine_rows(at_points, np.arange(0, 4 * ns + 1, 4), d.subcell_point.ravel(),
+                           (d.subcell_normal_length / d.subcell_area[:, None, None]).reshape(-1, 2))
+    return SmoothedGradients(cell, sub, evaluate(rk, p.x))
+
+
+def scni(p: Particles, rk: RKApproximation, domains: NodalDomains,
+         smoothed: SmoothedGradients | None = None) -> Quadrature:
+    """SCNI: smoothed gradients at the nodes, weights A_L (eq. 3.55)."""
+    s = smoothed or smoothed_gradients(p, rk, domains, subcells=False)
+    return Quadrature(p.x, domains.area, s.node_values, s.cell, "scni")
+
+
+def mscni_stabilization(p: Particles, rk: RKApproximation, domains: NodalDomains,
+                        smoothed: SmoothedGradients | None = None, eps_p: float = 1.0,
+                        with_values: bool = False) -> Quadrature:
+    """The subcell terms of eq. (3.56): rows grad~N(x_L) - grad~N(x_hat_C), weights eps_p A_C.
+
+    With ``with_values`` the value rows N(x_L) - N(x_hat_C) of eq. (3.58) are formed too.
+    """
+    if not eps_p >= 0:
+        raise InputError(f"eps_p = {eps_p!r} must be >= 0 (1 is the usual MSCNI choice)")
+    d = domains
+    s = smoothed if smoothed is not None and smoothed.subcell is not None else \
+        smoothed_gradients(p, rk, d, subcells=True)
+    ns = len(d.subcell_area)
+    src = stack_rows(s.cell, s.subcell)
+    diff = combine_rows(src, np.arange(0, 2 * ns + 1, 2),
+                        np.column_stack([d.subcell_node, p.num_nodes + np.arange(ns)]).ravel(),
+                        np.tile([1.0, -1.0], ns))
+    values = None
+    if with_values:
+        at_c = evaluate(rk, d.subcell_centroid)
+        values = combine_rows(stack_rows(s.node_values, at_c), np.arange(0, 2 * ns + 1, 2),
+                              np.column_stack([d.subcell_node, p.num_nodes + np.arange(ns)]).ravel(),
+                              np.tile([1.0, -1.0], ns))
+    return Quadrature(d.subcell_centroid, eps_p * d.subcell_area, values, diff, "mscni-stabilization")
+
+
+RULES = ("gauss1", "gauss2", "gauss4", "dni", "scni", "mscni")
+
+
+def integration_rules(name: str, p: Particles, rk: RKApproximation, domains: NodalDomains,
+                      eps_p: float = 1.0) -> list[Quadrature]:
+    """The quadratures of a named rule (``mscni`` gives two: SCNI and its stabilization)."""
+    if name.startswith("gauss") and name in RULES:
+        return [gauss(p, rk, int(name[5:]))]
+    if name == "dni":
+        return [dni(p, rk, domains)]
+    if name == "scni":
+        return [scni(p, rk, domains)]
+    if name == "mscni":
+        s = smoothed_gradients(p, rk, domains, subcells=True)
+        return [scni(p, rk, domains, s), mscni_stabilization(p, rk, domains, s, eps_p)]
+    raise InputError(f"unknown integration rule {name!r}; choose one of {', '.join(RULES)}")

@@ -1,0 +1,339 @@
+"""Reproducing kernel shape functions, eqs. (3.17)-(3.25), evaluated in bulk.
+
+``N_I(x) = H(0)^T A(x)^-1 H(x - x_I) Phi_a(x - x_I)`` with the cubic B-spline kernel and a
+linear (default) or quadratic monomial basis. Values and direct gradients at any number of
+points come out as CSR rows over the node index (points x neighbours), computed in parallel
+by compiled kernels. The basis is scaled by a length local to each point so that the moment
+matrix stays well conditioned for any node spacing; the shape functions do not depend on
+that scale.
+"""
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from .errors import InputError, SingularMomentMatrix, point_str
+from .kernel import cubic_spline
+from .sparse_rows import SparseRows
+from .neighbours import CHUNK, cell_grid, cell_range, count_covering
+
+# Reciprocal condition number of the scaled moment matrix below which it counts as singular.
+RCOND_MIN = 1e-10
+
+
+@dataclass(frozen=True)
+class RKApproximation:
+    """Nodes, supports and basis order of an RK approximation.
+
+    Attributes:
+        x: Node coordinates, shape ``(num_nodes, 2)`` [m].
+        support: Support radius a_I of each node, shape ``(num_nodes,)`` [m].
+        order: Degree of the complete monomial basis H (1 linear, 2 quadratic).
+    """
+
+    x: np.ndarray
+    support: np.ndarray
+    order: int = 1
+
+    @property
+    def num_nodes(self) -> int:
+        return len(self.x)
+
+
+def rk_approximation(x: np.ndarray, spacing: np.ndarray, support_factor: float = 1.5,
+                     order: int = 1) -> RKApproximation:
+    """RK approximation with support a_I = c * h_I.
+
+    Args:
+        x: Node coordinates, shape ``(num_nodes, 2)`` [m].
+        spacing: Nodal spacing h_I, shape ``(num_nodes,)`` [m].
+        support_factor: c > 0; 1.5 is the seed's choice for the linear basis.
+        order: 1 (linear) or 2 (quadratic) basis.
+    """
+    if not np.isfinite(support_factor) or support_factor <= 0:
+        raise InputError(f"support_factor = {support_factor!r} must be positive; use e.g. 1.5 "
+                         "(linear basis) or 2.5 (quadratic)")
+    if order not in (1, 2):
+        raise InputError(f"order = {order!r} is not supported; use 1 (linear) or 2 (quadratic)")
+    x = np.ascontiguousarray(x, dtype=np.float64)
+    spacing = np.broadcast_to(np.asarray(spacing, dtype=np.float64), (len(x),))
+    bad = np.flatnonzero(~(spacing > 0))
+    if bad.size:
+        i = bad[0]
+        raise InputError(f"node {i} at {point_str(x[i])} has spacing h = {spacing[i]}; spacings must be "
+                         "positive (check for duplicate nodes)")
+    return RKApproximation(x, np.ascontiguousarray(support_factor * spacing), order)
+
+
+@numba.njit(cache=True)
+def _cholesky_solve(m, rhs, nb):
+    """Solve the small SPD system m y = rhs in place; returns det(m) / prod(diag(m))."""
+    ratio = 1.0
+    for j in range(nb):
+        s = m[j, j]
+        for k in range(j):
+            s -= m[j, k] * m[j, k]
+        if not s > 0.0:
+            return 0.0
+        ratio *= s / m[j, j]
+        d = np.sqrt(s)
+        m[j, j] = d
+        for i in range(j + 1, nb):
+            t = m[i, j]
+            for k in range(j):
+                t -= m[i, k] * m[j, k]
+            m[i, j] = t / d
+    for c in range(rhs.shape[1]):
+        for i in range(nb):
+            t = rhs[i, c]
+            for k in range(i):
+                t -= m[i, k] * rhs[k, c]
+            rhs[i, c] = t / m[i, i]
+        for i in range(nb - 1, -1, -1):
+            t = rhs[i, c]
+            for k in range(i + 1, nb):
+                t -= m[k, i] * rhs[k, c]
+            rhs[i, c] = t / m[i, i]
+    return ratio
+
+
+@numba.njit(inline="always")
+def _gather(px, py, x, a, origin, cell, nx, ny, start, order, idx, dxs, dys, phis, dphis, inv):
+    """Nodes covering (px, py) with scaled offsets, kernel values and kernel gradients."""
+    x0, x1, y0, y1 = cell_range(px, py, origin, cell, nx, ny)
+    k = 0
+    for jy in range(y0, y1):
+        for jx in range(x0, x1):
+            cc = jy * nx + jx
+            for q in range(start[cc], start[cc + 1]):
+                j = order[q]
+                dx = px - x[j, 0]
+                dy = py - x[j, 1]
+                r2 = dx * dx + dy * dy
+                if r2 < a[j] * a[j]:
+                    r = np.sqrt(r2)
+                    phi, dphi = cubic_spline(r / a[j])
+                    idx[k] = j
+                    dxs[k] = dx * inv
+                    dys[k] = dy * inv
+                    phis[k] = phi
+                    g = dphi / (r * a[j]) if r > 0.0 else 0.0
+                    dphis[k, 0] = g * dx
+                    dphis[k, 1] = g * dy
+                    k += 1
+    return k
+
+
+@numba.njit(parallel=True, cache=True)
+def _rows_linear(x, a, points, scale, origin, cell, nx, ny, start, order, indptr, with_grad,
+                 indices, out, ratio):
+    """Linear-basis RK rows in closed form (3 x 3 moment matrix by cofactors)."""
+    m = points.shape[0]
+    kmax = 0
+    for p in range(m):
+        kmax = max(kmax, indptr[p + 1] - indptr[p])
+    for c in numba.prange((m + CHUNK - 1) // CHUNK):
+        idx = np.empty(kmax, np.int64)
+        dxs = np.empty(kmax)
+        dys = np.empty(kmax)
+        phis = np.empty(kmax)
+        dphis = np.empty((kmax, 2))
+        for p in range(c * CHUNK, min(m, (c + 1) * CHUNK)):
+            inv = 1.0 / scale[p]
+            n = _gather(points[p, 0], points[p, 1], x, a, origin, cell, nx, ny, start, order,
+                        idx, dxs, dys, phis, dphis, inv)
+            m00 = m01 = m02 = m11 = m12 = m22 = 0.0
+            for k in range(n):
+                f = phis[k]
+                m00 += f
+                m01 += f * dxs[k]
+                m02 += f * dys[k]
+                m11 += f * dxs[k] * dxs[k]
+                m12 += f * dxs[k] * dys[k]
+                m22 += f * dys[k] * dys[k]
+            c00 = m11 * m22 - m12 * m12
+            c01 = m02 * m12 - m01 * m22
+            c02 = m01 * m12 - m02 * m11
+            det = m00 * c00 + m01 * c01 + m02 * c02
+            hd = m00 * m11 * m22
+            ratio[p] = det / hd if hd > 0.0 else 0.0
+            if not ratio[p] > 1e-14:
+                ratio[p] = 0.0
+                continue
+            b0 = c00 / det
+            b1 = c01 / det
+            b2 = c02 / det
+            base = indptr[p]
+            if not with_grad:
+                for k in range(n):
+                    indices[base + k] = idx[k]
+                    out[base + k, 0] = (b0 + b1 * dxs[k] + b2 * dys[k]) * phis[k]
+                continue
+            # b_,i = -A^-1 A_,i b, with A^-1 = cofactors / det (symmetric).
+            c11 = m00 * m22 - m02 * m02
+            c12 = m01 * m02 - m00 * m12
+            c22 = m00 * m11 - m01 * m01
+            db = np.zeros((2, 3))
+            for i in range(2):
+                d00 = d01 = d02 = d11 = d12 = d22 = 0.0
+                for k in range(n):
+                    f = phis[k]
+                    g = dphis[k, i]
+                    u = dxs[k]
+                    v = dys[k]
+                    hu = inv if i == 0 else 0.0
+                    hv = inv if i == 1 else 0.0
+                    d00 += g
+                    d01 += hu * f + u * g
+                    d02 += hv * f + v * g
+                    d11 += 2.0 * u * hu * f + u * u * g
+                    d12 += (hu * v + u * hv) * f + u * v * g
+                    d22 += 2.0 * v * hv * f + v * v * g
+                r0 = d00 * b0 + d01 * b1 + d02 * b2
+                r1 = d01 * b0 + d11 * b1 + d12 * b2
+                r2 = d02 * b0 + d12 * b1 + d22 * b2
+                db[i, 0] = -(c00 * r0 + c01 * r1 + c02 * r2) / det
+                db[i, 1] = -(c01 * r0 + c11 * r1 + c12 * r2) / det
+                db[i, 2] = -(c02 * r0 + c12 * r1 + c22 * r2) / det
+            for k in range(n):
+                bh = b0 + b1 * dxs[k] + b2 * dys[k]
+                indices[base + k] = idx[k]
+                out[base + k, 0] = bh * phis[k]
+                out[base + k, 1] = ((db[0, 0] + db[0, 1] * dxs[k] + db[0, 2] * dys[k]) * phis[k]
+                                      + b1 * inv * phis[k] + bh * dphis[k, 0])
+                out[base + k, 2] = ((db[1, 0] + db[1, 1] * dxs[k] + db[1, 2] * dys[k]) * phis[k]
+                                      + b2 * inv * phis[k] + bh * dphis[k, 1])
+
+
+@numba.njit(inline="always")
+def _basis(u, v, order, h):
+    """Monomials H at scaled offsets (u, v) and their derivatives w.r.t. (u, v)."""
+    if order == 1:
+        h[0, 0] = 1.0; h[0, 1] = u; h[0, 2] = v
+        h[1, 0] = 0.0; h[1, 1] = 1.0; h[1, 2] = 0.0
+        h[2, 0] = 0.0; h[2, 1] = 0.0; h[2, 2] = 1.0
+    else:
+        h[0, 0] = 1.0; h[0, 1] = u; h[0, 2] = v; h[0, 3] = u * u; h[0, 4] = u * v; h[0, 5] = v * v
+        h[1, 0] = 0.0; h[1, 1] = 1.0; h[1, 2] = 0.0; h[1, 3] = 2 * u; h[1, 4] = v; h[1, 5] = 0.0
+        h[2, 0] = 0.0; h[2, 1] = 0.0; h[2, 2] = 1.0; h[2, 3] = 0.0; h[2, 4] = u; h[2, 5] = 2 * v
+
+
+@numba.njit(parallel=True, cache=True)
+def _rows_generic(x, a, points, scale, origin, cell, nx, ny, start, order, indptr, with_grad,
+                  basis_order, indices, out, ratio):
+    """RK rows for any basis order: moment matrix (3.24) solved by Cholesky."""
+    nb = 3 if basis_order == 1 else 6
+    m = points.shape[0]
+    kmax = 0
+    for p in range(m):
+        kmax = max(kmax, indptr[p + 1] - indptr[p])
+    for c in numba.prange((m + CHUNK - 1) // CHUNK):
+        idx = np.empty(kmax, np.int64)
+        dxs = np.empty(kmax)
+        dys = np.empty(kmax)
+        phis = np.empty(kmax)
+        dphis = np.empty((kmax, 2))
+        mom = np.empty((nb, nb))
+        dmom = np.empty((2, nb, nb))
+        fac = np.empty((nb, nb))
+        rhs = np.empty((nb, 3))
+        h = np.empty((3, nb))
+        for p in range(c * CHUNK, min(m, (c + 1) * CHUNK)):
+            inv = 1.0 / scale[p]
+            n = _gather(points[p, 0], points[p, 1], x, a, origin, cell, nx, ny, start, order,
+                        idx, dxs, dys, phis, dphis, inv)
+            mom[:] = 0.0
+            dmom[:] = 0.0
+            for k in range(n):
+                _basis(dxs[k], dys[k], basis_order, h)
+                for i in range(nb):
+                    for j in range(i, nb):
+                        hh = h[0, i] * h[0, j]
+                        mom[i, j] += hh * phis[k]
+                        if with_grad:
+                            for d in range(2):
+                                dmom[d, i, j] += ((h[d + 1, i] * h[0, j] + h[0, i] * h[d + 1, j]) * inv * phis[k]
+                                                  + hh * dphis[k, d])
+            for i in range(nb):
+                for j in range(i):
+                    mom[i, j] = mom[j, i]
+                    dmom[0, i, j] = dmom[0, j, i]
+                    dmom[1, i, j] = dmom[1, j, i]
+            rhs[:] = 0.0
+            rhs[0, 0] = 1.0
+            fac[:] = mom
+            ratio[p] = _cholesky_solve(fac, rhs[:, :1], nb)
+            if not ratio[p] > 1e-14:
+                ratio[p] = 0.0
+                continue
+            if with_grad:
+                for d in range(2):
+                    for i in range(nb):
+                        t = 0.0
+                        for j in range(nb):
+                            t -= dmom[d, i, j] * rhs[j, 0]
+                        rhs[i, d + 1] = t
+                fac[:] = mom
+                _cholesky_solve(fac, rhs[:, 1:], nb)
+            base = indptr[p]
+            for k in range(n):
+                _basis(dxs[k], dys[k], basis_order, h)
+                bh = 0.0
+                for i in range(nb):
+                    bh += rhs[i, 0] * h[0, i]
+                indices[base + k] = idx[k]
+                out[base + k, 0] = bh * phis[k]
+                if with_grad:
+                    for d in range(2):
+                        t = 0.0
+                        hd = 0.0
+                        for i in range(nb):
+                            t += rhs[i, d + 1] * h[0, i]
+                            hd += rhs[i, 0] * h[d + 1, i]
+                        out[base + k, d + 1] = t * phis[k] + hd * inv * phis[k] + bh * dphis[k, d]
+
+
+def evaluate(rk: RKApproximation, points: np.ndarray, gradients: bool = False) -> SparseRows:
+    """Shape functions N_I (and their direct gradients) at points.
+
+    Returns rows over nodes whose entry vectors are ``[N_I]``, or ``[N_I, N_I,x, N_I,y]`` with
+    ``gradients=True``.
+
+    Args:
+        rk: The approximation.
+        points: Evaluation points, shape ``(num_points, 2)`` [m].
+        gradients: Also compute direct gradients (3.25 differentiated).
+
+    Raises:
+        SingularMomentMatrix: At a point covered by too few, or collinear, supports; the
+            message names the point and its nearest node and suggests a larger support.
+    """
+    points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
+    g = cell_grid(rk.x, rk.support, points)
+    grid = (g.origin, g.cell, *g.shape, g.start, g.order)
+    counts = count_covering(rk.x, rk.support, points, *grid)
+    indptr = np.zeros(len(points) + 1, np.int64)
+    np.cumsum(counts, out=indptr[1:])
+    nnz = int(indptr[-1])
+    indices = np.empty(nnz, np.int32)
+    out = np.empty((nnz, 3 if gradients else 1))
+    ratio = np.zeros(len(points))
+    # Basis scale: any length of the order of the supports; N_I does not depend on it.
+    scale = np.full(len(points), float(np.median(rk.support)))
+    if rk.order == 1:
+        _rows_linear(rk.x, rk.support, points, scale, *grid, indptr, gradients,
+                     indices, out, ratio)
+    else:
+        _rows_generic(rk.x, rk.support, points, scale, *grid, indptr, gradients, rk.order,
+                      indices, out, ratio)
+    bad = np.flatnonzero(~(ratio >= RCOND_MIN))
+    if bad.size:
+        p = bad[0]
+        near = int(np.argmin(np.sum((rk.x - points[p]) ** 2, axis=1)))
+        raise SingularMomentMatrix(
+            f"singular moment matrix at point {p} {point_str(points[p])} "
+            f"({len(bad)} such points): covered by {counts[p]} node supports "
+            f"(nearest node {near} at {point_str(rk.x[near])}, support "
+            f"{rk.support[near]:.4g}); increase support_factor, it needs >= "
+            f"{(rk.order + 1) * (rk.order + 2) // 2} non-collinear nodes in reach of every point")
+    return SparseRows(indptr, indices, out, rk.num_nodes)
