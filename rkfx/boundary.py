@@ -138,7 +138,7 @@ def nitsche_terms(p: Particles, bq: BoundaryQuadrature, d: np.ndarray, dirichlet
     if not penalty > 0:
         raise InputError(f"Nitsche penalty = {penalty!r} must be positive (e.g. 100)")
     from .elasticity import traction_operator  # noqa: PLC0415
-    from .operators import strain_matrix  # noqa: PLC0415
+    from .operators import block_diagonal, strain_matrix  # noqa: PLC0415
 
     n2 = 2 * p.num_nodes
     k_total = sp.csr_matrix((n2, n2))
@@ -159,8 +159,7 @@ def nitsche_terms(p: Particles, bq: BoundaryQuadrature, d: np.ndarray, dirichlet
         # Traction rows t_c(u)(x_q) = (T D B u)_c for the same components.
         bq_rows = b_all[np.ravel(3 * sel[:, None] + np.arange(3))]
         tdb = np.einsum("mij,jk->mik", traction_operator(bq.normals[sel]), d)
-        blocks = sp.block_diag(list(tdb), format="csr")
-        trac = blocks @ bq_rows  # (2 m, 2n), rows (q, component)
+        trac = block_diagonal(tdb) @ bq_rows  # (2 m, 2n), rows (q, component)
         trac = sp.vstack([trac[c::2] for c in comps]).tocsr()
         wc = np.tile(w, len(comps))
         beta = penalty * d[0, 0] / np.tile(bq.spacing[sel], len(comps))

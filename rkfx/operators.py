@@ -26,15 +26,15 @@ def weighted_product(b: sp.csr_matrix, weights: np.ndarray, d: np.ndarray) -> sp
     """``B^T diag_q(w_q D) B`` for a point-wise constant ``d`` of shape ``(k, k)`` (or ``(m, k, k)``)."""
     k = b.shape[0] // len(weights)
     d = np.broadcast_to(d, (len(weights), k, k))
-    return (b.T @ _block_diagonal(weights[:, None, None] * d) @ b).tocsr()
+    return (b.T @ block_diagonal(weights[:, None, None] * d) @ b).tocsr()
 
 
-def _block_diagonal(blocks: np.ndarray) -> sp.csr_matrix:
-    m, k, _ = blocks.shape
-    base = k * np.arange(m)
-    rows = np.broadcast_to(base[:, None, None] + np.arange(k)[None, :, None], blocks.shape)
-    cols = np.broadcast_to(base[:, None, None] + np.arange(k)[None, None, :], blocks.shape)
-    return sp.csr_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())), shape=(m * k, m * k))
+def block_diagonal(blocks: np.ndarray) -> sp.csr_matrix:
+    """Sparse block-diagonal matrix of ``m`` dense blocks, ``blocks`` of shape ``(m, r, c)``."""
+    m, r, c = blocks.shape
+    rows = np.broadcast_to((r * np.arange(m))[:, None, None] + np.arange(r)[None, :, None], blocks.shape)
+    cols = np.broadcast_to((c * np.arange(m))[:, None, None] + np.arange(c)[None, None, :], blocks.shape)
+    return sp.csr_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())), shape=(m * r, m * c))
 
 
 def stiffness(quadratures: list[Quadrature], d: np.ndarray) -> sp.csr_matrix:

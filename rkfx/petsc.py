@@ -71,7 +71,10 @@ def make_ksp(mat: PETSc.Mat, solver: str = "mumps", rtol: float = 1e-12, prefix:
         pc.setFactorSetUpSolverType()
         # Saddle-point systems (multiplier constraints, u-p coupling) delay pivots: give MUMPS
         # room for them (ICNTL(14): % extra workspace) instead of failing with INFOG(1) = -9.
-        pc.getFactorMatrix().setMumpsIcntl(14, 200)
+        factor = pc.getFactorMatrix()
+        factor.setMumpsIcntl(14, 200)
+        # Detect null pivots so that a singular system is reported, not "solved".
+        factor.setMumpsIcntl(24, 1)
     elif solver == "gmres-ilu":
         ksp.setType("gmres")
         pc.setType("asm" if mat.getComm().size > 1 else "ilu")
@@ -100,11 +103,23 @@ def solve(a: sp.spmatrix, b: np.ndarray, comm=MPI.COMM_WORLD, solver: str = "mum
         raise SolverDiverged(f"PETSc solver {solver!r} failed ({err}); the system may be singular: "
                              "check that essential boundary conditions remove all rigid-body modes") from None
     reason = ksp.getConvergedReason()
+    if solver == "mumps":
+        null_pivots = ksp.getPC().getFactorMatrix().getMumpsInfog(28)
+        if null_pivots > 0:
+            raise SolverDiverged(f"the system matrix is singular ({null_pivots} null pivots): essential "
+                                 "boundary conditions must remove all rigid-body modes")
     if reason < 0:
         raise SolverDiverged(f"PETSc solver {solver!r} diverged (KSPConvergedReason {reason}) after "
                              f"{ksp.getIterationNumber()} iterations; try solver='mumps' or check the "
                              "boundary conditions")
+    residual = mat.createVecLeft()
+    mat.mult(x, residual)
+    residual.axpy(-1.0, rhs)
+    if residual.norm() > 1e-6 * max(rhs.norm(), 1e-300):
+        raise SolverDiverged(f"PETSc solver {solver!r} left a relative residual of "
+                             f"{residual.norm() / max(rhs.norm(), 1e-300):.2e}: the system is singular or "
+                             "ill-conditioned; check the boundary conditions")
     out = gather(x)
-    for obj in (ksp, mat, rhs, x):
+    for obj in (ksp, mat, rhs, x, residual):
         obj.destroy()
     return out

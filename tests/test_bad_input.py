@@ -1,0 +1,80 @@
+"""Bad input raises one clear error naming the culprit and the fix — never a bare LinAlgError or NaN."""
+import numpy as np
+import pytest
+
+from rkfx.boundary import Dirichlet
+from rkfx.elasticity import ElasticMaterial
+from rkfx.elastostatics import solve_plane_strain
+from rkfx.errors import InputError, SingularMomentMatrix
+from rkfx.particles import from_points, particles, structured
+from rkfx.quadrature import integration_rules
+from rkfx.shape_functions import evaluate, rk_approximation
+
+
+def test_support_too_small_names_the_point_and_the_fix():
+    p = structured(1.0, 1.0, 6, 6)
+    rk = rk_approximation(p.x, p.spacing, support_factor=0.6)
+    with pytest.raises(SingularMomentMatrix, match=r"singular moment matrix at point \d+ \(.*increase support_factor"):
+        evaluate(rk, np.array([[0.1, 0.1]]))
+
+
+def test_collinear_neighbours_are_singular():
+    x = np.column_stack([np.linspace(0, 1, 11), np.zeros(11)])
+    rk = rk_approximation(x, np.full(11, 0.1), support_factor=3.0)
+    with pytest.raises(SingularMomentMatrix, match="non-collinear"):
+        evaluate(rk, np.array([[0.5, 0.0]]))
+
+
+def test_point_outside_every_support():
+    p = structured(1.0, 1.0, 5, 5)
+    rk = rk_approximation(p.x, p.spacing)
+    with pytest.raises(SingularMomentMatrix, match="covered by 0 node supports"):
+        evaluate(rk, np.array([[5.0, 5.0]]))
+
+
+@pytest.mark.parametrize("factor", [0.0, -1.5, np.nan])
+def test_non_positive_support_factor(factor):
+    with pytest.raises(InputError, match="support_factor"):
+        rk_approximation(np.zeros((3, 2)), np.ones(3), support_factor=factor)
+
+
+@pytest.mark.parametrize("E, nu, name", [(0.0, 0.3, "Young"), (-1.0, 0.3, "Young"), (1.0, 0.5, "Poisson"),
+                                         (1.0, -1.0, "Poisson"), (1.0, 0.7, "Poisson")])
+def test_invalid_elastic_constants(E, nu, name):
+    with pytest.raises(InputError, match=f"{name}.*= {E if name == 'Young' else nu}"):
+        ElasticMaterial(E, nu)
+
+
+def test_node_outside_the_geometry():
+    poly = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    x = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0.5, 0.5], [1.5, 0.5]], float)
+    with pytest.raises(InputError, match=r"node 5 at \(1.5, 0.5\) lies outside the geometry"):
+        from_points(x, poly)
+
+
+def test_duplicate_nodes_are_degenerate():
+    x = np.array([[0, 0], [1, 0], [0, 1], [0, 1]], float)
+    with pytest.raises(InputError, match="degenerate triangle"):
+        particles(x, np.array([[0, 1, 2], [1, 2, 3]]))
+
+
+def test_unknown_options():
+    p = structured(1.0, 1.0, 4, 4)
+    rk = rk_approximation(p.x, p.spacing)
+    with pytest.raises(InputError, match="unknown integration rule 'foo'; choose one of"):
+        integration_rules("foo", p, rk, None)
+    with pytest.raises(InputError, match="unknown boundary 'side'"):
+        p.boundary_nodes("side")
+    with pytest.raises(InputError, match="unknown bc_method"):
+        solve_plane_strain(p, ElasticMaterial(1, 0.3), [], bc_method="lagrange")
+
+
+def test_missing_constraints_report_a_singular_system():
+    """No displacement boundary conditions: rigid modes make K singular; the solver says so."""
+    pytest.importorskip("petsc4py")
+    from rkfx.petsc import SolverDiverged
+
+    p = structured(1.0, 1.0, 5, 5)
+    with pytest.raises(SolverDiverged, match="rigid-body modes|diverged"):
+        sol = solve_plane_strain(p, ElasticMaterial(1, 0.3), [Dirichlet("left", lambda x: 0 * x, (0,))])
+        assert np.all(np.isfinite(sol.coefficients))  # reached only if the solve did not flag it
