@@ -80,16 +80,38 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, dirichlet: Seque
         f += load_vector(q.values, q.weights, body_force(q.points))
     times["assemble"] = time.perf_counter() - t0
     t0 = time.perf_counter()
+    g, gv = transformation_constraints(p, rk, dirichlet)
+    _check_rigid_modes(p, g)
     if bc_method == "nitsche":
         kn, fn = nitsche_terms(p, bq, d, dirichlet, nitsche_penalty)
         system, rhs = k + kn, f + fn
     else:
-        g, gv = transformation_constraints(p, rk, dirichlet)
         system = sp.bmat([[k, g.T], [g, None]], format="csr")
         rhs = np.concatenate([f, gv])
     x = _linear_solve(system, rhs, comm, solver)
     times["solve"] = time.perf_counter() - t0
     return ElasticSolution(rk, x[:2 * p.num_nodes].reshape(-1, 2), 2 * p.num_nodes, times)
+
+
+def _check_rigid_modes(p: Particles, g: sp.csr_matrix) -> None:
+    """Raise if the prescribed displacements leave a rigid-body mode free (K would be singular).
+
+    RK shape functions reproduce linear fields, so coefficients equal to the rigid motions'
+    nodal values are exactly the rigid modes; each must violate some constraint row.
+    """
+    x = p.x - p.x.mean(axis=0)
+    modes = np.zeros((2 * p.num_nodes, 3))
+    modes[0::2, 0] = 1.0
+    modes[1::2, 1] = 1.0
+    modes[0::2, 2], modes[1::2, 2] = -x[:, 1], x[:, 0]
+    seen = g @ modes if g.shape[0] else np.zeros((0, 3))
+    sv = np.linalg.svd(seen, compute_uv=False) if len(seen) else np.zeros(0)
+    scale = np.abs(modes).max()
+    if len(sv) < 3 or sv[-1] <= 1e-10 * scale * max(sv[0], 1.0):
+        free = [name for name, k in (("x-translation", 0), ("y-translation", 1), ("rotation", 2))
+                if not np.any(np.abs(seen[:, k]) > 1e-12 * scale)] or ["a combination of rigid motions"]
+        raise InputError(f"the displacement conditions leave {', '.join(free)} free, so the stiffness is "
+                         "singular; prescribe more components (e.g. a roller on a second boundary)")
 
 
 def _linear_solve(a, b, comm, solver):

@@ -88,24 +88,84 @@ def _normal_length(p, q):
     return np.stack([d[..., 1], -d[..., 0]], axis=-1)
 
 
-def _quad_moments(v):
-    """Area, centroid and second moments about vertex 0 of CCW quads v, shape (s, 4, 2)."""
-    r = v - v[:, :1]
-    x0, y0 = r[..., 0], r[..., 1]
-    x1, y1 = np.roll(x0, -1, axis=1), np.roll(y0, -1, axis=1)
-    cross = x0 * y1 - x1 * y0
-    area = 0.5 * cross.sum(axis=1)
-    cx = ((x0 + x1) * cross).sum(axis=1) / (6.0 * area)
-    cy = ((y0 + y1) * cross).sum(axis=1) / (6.0 * area)
-    ixx = (cross * (x0 * x0 + x0 * x1 + x1 * x1)).sum(axis=1) / 12.0
-    iyy = (cross * (y0 * y0 + y0 * y1 + y1 * y1)).sum(axis=1) / 12.0
-    ixy = (cross * (x0 * y1 + 2 * x0 * y0 + 2 * x1 * y1 + x1 * y0)).sum(axis=1) / 24.0
-    centroid = v[:, 0] + np.column_stack([cx, cy])
-    return area, centroid, np.column_stack([ixx, ixy, iyy])
+@numba.njit(parallel=True, cache=True)
+def _subcells(x, tri, tri_edges, edges):
+    """Smoothing points and, per subcell (v, m_k, g, m_k-1), its area, centroid, second
+    moments about v, and the outward normal x length and smoothing point of each side."""
+    nt = tri.shape[0]
+    ne = edges.shape[0]
+    ns = 3 * nt
+    points = np.empty((3 * nt + 2 * ne, 2))
+    area = np.empty(ns)
+    centroid = np.empty((ns, 2))
+    moments = np.empty((ns, 3))
+    nl = np.empty((ns, 4, 2))
+    side_point = np.empty((ns, 4), np.int64)
+    for e in numba.prange(ne):
+        i, j = edges[e, 0], edges[e, 1]
+        for d in range(2):
+            points[3 * nt + e, d] = 0.75 * x[i, d] + 0.25 * x[j, d]
+            points[3 * nt + ne + e, d] = 0.25 * x[i, d] + 0.75 * x[j, d]
+    for t in numba.prange(nt):
+        qx = np.empty(4)
+        qy = np.empty(4)
+        gx = (x[tri[t, 0], 0] + x[tri[t, 1], 0] + x[tri[t, 2], 0]) / 3.0
+        gy = (x[tri[t, 0], 1] + x[tri[t, 1], 1] + x[tri[t, 2], 1]) / 3.0
+        for k in range(3):
+            a, b = tri[t, k], tri[t, (k + 1) % 3]
+            points[3 * t + k, 0] = 0.5 * (0.5 * (x[a, 0] + x[b, 0]) + gx)
+            points[3 * t + k, 1] = 0.5 * (0.5 * (x[a, 1] + x[b, 1]) + gy)
+        for k in range(3):
+            s = 3 * t + k
+            v = tri[t, k]
+            nxt = tri[t, (k + 1) % 3]
+            prv = tri[t, (k + 2) % 3]
+            e_k = tri_edges[t, k]
+            e_p = tri_edges[t, (k + 2) % 3]
+            # Vertices relative to v: v, m_k, g, m_{k-1} (counter-clockwise). The midpoints are
+            # formed as in the smoothing points so shared sides cancel exactly.
+            qx[0] = 0.0
+            qy[0] = 0.0
+            qx[1] = 0.5 * (x[v, 0] + x[nxt, 0]) - x[v, 0]
+            qy[1] = 0.5 * (x[v, 1] + x[nxt, 1]) - x[v, 1]
+            qx[2] = gx - x[v, 0]
+            qy[2] = gy - x[v, 1]
+            qx[3] = 0.5 * (x[prv, 0] + x[v, 0]) - x[v, 0]
+            qy[3] = 0.5 * (x[prv, 1] + x[v, 1]) - x[v, 1]
+            a2 = 0.0
+            cx = 0.0
+            cy = 0.0
+            ixx = 0.0
+            ixy = 0.0
+            iyy = 0.0
+            for i in range(4):
+                j = (i + 1) % 4
+                c = qx[i] * qy[j] - qx[j] * qy[i]
+                a2 += c
+                cx += (qx[i] + qx[j]) * c
+                cy += (qy[i] + qy[j]) * c
+                ixx += c * (qx[i] * qx[i] + qx[i] * qx[j] + qx[j] * qx[j])
+                iyy += c * (qy[i] * qy[i] + qy[i] * qy[j] + qy[j] * qy[j])
+                ixy += c * (qx[i] * qy[j] + 2 * qx[i] * qy[i] + 2 * qx[j] * qy[j] + qx[j] * qy[i])
+                nl[s, i, 0] = qy[j] - qy[i]
+                nl[s, i, 1] = -(qx[j] - qx[i])
+            area[s] = 0.5 * a2
+            centroid[s, 0] = x[v, 0] + cx / (3.0 * a2)
+            centroid[s, 1] = x[v, 1] + cy / (3.0 * a2)
+            moments[s, 0] = ixx / 12.0
+            moments[s, 1] = ixy / 24.0
+            moments[s, 2] = iyy / 12.0
+            # Side midpoints: quarter point of edge k near v, the two m-g midpoints, quarter
+            # point of edge k-1 near v.
+            side_point[s, 0] = 3 * nt + e_k + (ne if edges[e_k, 1] == v else 0)
+            side_point[s, 1] = 3 * t + k
+            side_point[s, 2] = 3 * t + (k + 2) % 3
+            side_point[s, 3] = 3 * nt + e_p + (ne if edges[e_p, 1] == v else 0)
+    return points, area, centroid, moments, nl, side_point
 
 
 @numba.njit(cache=True)
-def _cell_lists(n, tri, edge_of, is_boundary, seg_point, quarter_point, nl_sub):
+def _cell_lists(n, tri, edge_of, is_boundary, side_point, nl_sub):
     """Per-node cell-boundary segments: the two m-g sides of each subcell, plus boundary half-edges."""
     t_count = tri.shape[0]
     count = np.zeros(n + 1, np.int64)
@@ -128,7 +188,7 @@ def _cell_lists(n, tri, edge_of, is_boundary, seg_point, quarter_point, nl_sub):
                     continue
                 if side == 3 and not is_boundary[edge_of[t, (k + 2) % 3]]:
                     continue
-                point[fill[v]] = quarter_point[s, side] if side in (0, 3) else seg_point[s, side]
+                point[fill[v]] = side_point[s, side]
                 nl[fill[v], 0] = nl_sub[s, side, 0]
                 nl[fill[v], 1] = nl_sub[s, side, 1]
                 fill[v] += 1
@@ -136,65 +196,43 @@ def _cell_lists(n, tri, edge_of, is_boundary, seg_point, quarter_point, nl_sub):
 
 
 def nodal_domains(p: Particles) -> NodalDomains:
-    """Median-dual nodal domains of a ``Particles`` set (vectorised over triangles)."""
+    """Median-dual nodal domains of a ``Particles`` set (compiled loops over triangles)."""
     x, tri, n = p.x, p.triangles, p.num_nodes
-    nt = len(tri)
-    xt = x[tri]  # (t, 3, 2)
-    g = xt.mean(axis=1)
-    mid = 0.5 * (xt + np.roll(xt, -1, axis=1))  # mid[:, k] on edge (v_k, v_k+1)
-    # Unique undirected edges; edge_of[t, k] is the edge (v_k, v_k+1).
-    directed = np.stack([tri, np.roll(tri, -1, axis=1)], axis=-1).reshape(-1, 2)
-    lo = directed.min(axis=1)
-    hi = directed.max(axis=1)
-    uniq, edge_of, counts = np.unique(lo * n + hi, return_inverse=True, return_counts=True)
-    edge_of = edge_of.reshape(nt, 3)
-    ne = len(uniq)
-    is_boundary = (counts == 1).astype(np.int64)
-    e_lo, e_hi = uniq // n, uniq % n
-    # Smoothing points: 3 per triangle (midpoints of m_k -> g), then 2 per edge (quarter points).
-    seg_mid = 0.5 * (mid + g[:, None, :])  # (t, 3, 2)
-    quarter = np.concatenate([0.75 * x[e_lo] + 0.25 * x[e_hi], 0.25 * x[e_lo] + 0.75 * x[e_hi]])
-    smoothing_points = np.concatenate([seg_mid.reshape(-1, 2), quarter])
-
-    def quarter_index(node, edge):
-        return 3 * nt + edge + ne * (node == e_hi[edge])
-
-    # Subcell of vertex k of triangle t: (v_k, m_k, g, m_{k-1}); row 3 t + k.
-    vk = xt
-    mk = mid
-    mkm = np.roll(mid, 1, axis=1)
-    gg = np.broadcast_to(g[:, None, :], xt.shape)
-    quads = np.stack([vk, mk, gg, mkm], axis=2).reshape(-1, 4, 2)
-    area, centroid, moments = _quad_moments(quads)
-    nl = _normal_length(quads, np.roll(quads, -1, axis=1))  # (s, 4, 2)
-    tt = np.repeat(np.arange(nt), 3)
-    kk = np.tile(np.arange(3), nt)
-    node = tri.reshape(-1)
-    e_k = edge_of[tt, kk]
-    e_km = edge_of[tt, (kk + 2) % 3]
-    seg_point = np.column_stack([np.zeros(len(tt), np.int64), 3 * tt + kk, 3 * tt + (kk + 2) % 3,
-                                 np.zeros(len(tt), np.int64)])
-    quarter_point = np.column_stack([quarter_index(node, e_k), np.zeros(len(tt), np.int64),
-                                     np.zeros(len(tt), np.int64), quarter_index(node, e_km)])
-    subcell_point = seg_point + quarter_point
-    cell_ptr, cell_point, cell_nl = _cell_lists(n, tri, edge_of, is_boundary, seg_point, quarter_point, nl)
-    # Boundary: each boundary edge (i -> j, domain on the left) split at its midpoint.
+    edges, edge_of = p.edges, p.triangle_edges
+    ne = len(edges)
+    points, area, centroid, moments, nl, side_point = _subcells(x, tri, edge_of, edges)
+    is_boundary = (np.bincount(edge_of.ravel(), minlength=ne) == 1).astype(np.int64)
+    cell_ptr, cell_point, cell_nl = _cell_lists(n, tri, edge_of, is_boundary, side_point, nl)
+    # Boundary: each boundary edge (i -> j, domain on the left) split at its midpoint; the
+    # half-segment midpoints are the edge's quarter points.
     be = p.boundary_edges
-    bkey = be.min(axis=1) * n + be.max(axis=1)
-    bedge = np.searchsorted(uniq, bkey)
+    bedge = _edge_index(edges, be.min(axis=1), be.max(axis=1))
     xm = 0.5 * (x[be[:, 0]] + x[be[:, 1]])
     ends = np.concatenate([np.stack([x[be[:, 0]], xm], 1), np.stack([xm, x[be[:, 1]]], 1)])
     bnode = np.concatenate([be[:, 0], be[:, 1]])
     bnl = _normal_length(ends[:, 0], ends[:, 1])
     blen = np.linalg.norm(bnl, axis=1)
+    both = np.concatenate([bedge, bedge])
     boundary = BoundarySegments(
         node=bnode, ends=ends, normal=bnl / blen[:, None], length=blen,
         tag=np.concatenate([p.boundary_tags, p.boundary_tags]),
-        point=quarter_index(bnode, np.concatenate([bedge, bedge])))
+        point=3 * len(tri) + both + ne * (bnode == edges[both, 1]))
+    node = tri.reshape(-1)
     return NodalDomains(
         area=np.bincount(node, area, n),
         second_moment=np.column_stack([np.bincount(node, moments[:, c], n) for c in range(3)]),
         subcell_node=node, subcell_area=area, subcell_centroid=centroid,
-        smoothing_points=smoothing_points, subcell_point=subcell_point,
+        smoothing_points=points, subcell_point=side_point,
         subcell_normal_length=nl, cell_ptr=cell_ptr, cell_point=cell_point,
         cell_normal_length=cell_nl, boundary=boundary)
+
+
+def _edge_index(edges: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Index of the edges (lo, hi) in ``edges``, which is sorted by low node."""
+    idx = np.searchsorted(edges[:, 0], lo)
+    for _ in range(64):  # a node has few edges: step to the matching high node
+        miss = edges[idx, 1] != hi
+        if not miss.any():
+            return idx
+        idx[miss] += 1
+    raise AssertionError("boundary edge not found among the triangulation's edges")

@@ -8,6 +8,7 @@ the conforming nodal domains (``rkfx.nodal_domains``). Factories: ``structured``
 """
 from dataclasses import dataclass, field
 
+import numba
 import numpy as np
 from scipy.spatial import Delaunay
 
@@ -26,6 +27,8 @@ class Particles:
             shape ``(num_boundary_edges, 2)``.
         boundary_tags: Tag of each boundary edge, shape ``(num_boundary_edges,)``; 0 = untagged.
         boundary_names: Name -> tag.
+        edges: Unique triangulation edges (i < j), shape ``(num_edges, 2)``.
+        triangle_edges: Edge index of side k = (v_k, v_k+1) of each triangle, shape ``(num_triangles, 3)``.
     """
 
     x: np.ndarray
@@ -34,6 +37,8 @@ class Particles:
     boundary_edges: np.ndarray
     boundary_tags: np.ndarray
     boundary_names: dict[str, int] = field(default_factory=dict)
+    edges: np.ndarray | None = None
+    triangle_edges: np.ndarray | None = None
 
     @property
     def num_nodes(self) -> int:
@@ -62,6 +67,62 @@ def _triangle_areas(x, tri):
     e1 = x[tri[:, 1]] - x[tri[:, 0]]
     e2 = x[tri[:, 2]] - x[tri[:, 0]]
     return 0.5 * (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+
+
+@numba.njit(cache=True)
+def unique_edges(tri: np.ndarray, n: int):
+    """Unique edges of a triangulation in O(N).
+
+    Returns ``(edges, triangle_edges, count)``: edges (i < j) ordered by i, shape ``(e, 2)``; the
+    edge of side (v_k, v_k+1) of each triangle, shape ``(t, 3)``; triangles per edge, shape ``(e,)``.
+    """
+    nt = tri.shape[0]
+    deg = np.zeros(n + 1, np.int64)
+    for t in range(nt):
+        for k in range(3):
+            a, b = tri[t, k], tri[t, (k + 1) % 3]
+            deg[min(a, b) + 1] += 1
+    for i in range(n):
+        deg[i + 1] += deg[i]
+    # Candidate partners of each low node (with repeats), then de-duplicated in place.
+    partner = np.empty(deg[n], np.int64)
+    fill = deg[:-1].copy()
+    for t in range(nt):
+        for k in range(3):
+            a, b = tri[t, k], tri[t, (k + 1) % 3]
+            lo = min(a, b)
+            partner[fill[lo]] = max(a, b)
+            fill[lo] += 1
+    start = np.zeros(n + 1, np.int64)
+    for i in range(n):
+        m = deg[i]
+        for q in range(deg[i], deg[i + 1]):
+            dup = False
+            for r in range(deg[i], m):
+                if partner[r] == partner[q]:
+                    dup = True
+                    break
+            if not dup:
+                partner[m] = partner[q]
+                m += 1
+        start[i + 1] = start[i] + (m - deg[i])
+    edges = np.empty((start[n], 2), np.int64)
+    for i in range(n):
+        for q in range(start[i + 1] - start[i]):
+            edges[start[i] + q, 0] = i
+            edges[start[i] + q, 1] = partner[deg[i] + q]
+    triangle_edges = np.empty((nt, 3), np.int64)
+    count = np.zeros(start[n], np.int64)
+    for t in range(nt):
+        for k in range(3):
+            a, b = tri[t, k], tri[t, (k + 1) % 3]
+            lo, hi = min(a, b), max(a, b)
+            for e in range(start[lo], start[lo + 1]):
+                if edges[e, 1] == hi:
+                    triangle_edges[t, k] = e
+                    count[e] += 1
+                    break
+    return edges, triangle_edges, count
 
 
 def _edge_keys(edges, n):
@@ -108,34 +169,32 @@ def particles(x: np.ndarray, triangles: np.ndarray, tagged_edges: dict[str, np.n
         raise InputError(f"degenerate triangle {tiny[0]} with nodes {t.tolist()} at {x[t].tolist()}; "
                          "duplicate or collinear nodes — remove duplicates or re-mesh")
     # Boundary edges: those of one triangle, kept in the triangle's counter-clockwise sense.
-    directed = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
-    keys = _edge_keys(directed, n)
-    uniq, inverse, counts = np.unique(keys, return_inverse=True, return_counts=True)
+    edges, tri_edges, counts = unique_edges(tri, n)
     if counts.max() > 2:
-        k = uniq[np.argmax(counts)]
-        raise InputError(f"edge ({k // n}, {k % n}) is shared by {counts.max()} triangles; the "
+        e = edges[np.argmax(counts)]
+        raise InputError(f"edge ({e[0]}, {e[1]}) is shared by {counts.max()} triangles; the "
                          "triangulation overlaps itself — re-mesh")
-    bmask = counts[inverse] == 1
-    bedges = directed[bmask]
-    bkeys = keys[bmask]
+    t_b, k_b = np.nonzero(counts[tri_edges] == 1)
+    bedges = np.column_stack([tri[t_b, k_b], tri[t_b, (k_b + 1) % 3]])
+    bkeys = _edge_keys(bedges, n)
     tags = np.zeros(len(bedges), np.int64)
     names = {}
-    for t, (name, edges) in enumerate((tagged_edges or {}).items(), start=1):
+    for t, (name, part) in enumerate((tagged_edges or {}).items(), start=1):
         names[name] = t
-        ek = _edge_keys(np.asarray(edges, dtype=np.int64).reshape(-1, 2), n)
+        ek = _edge_keys(np.asarray(part, dtype=np.int64).reshape(-1, 2), n)
         hit = np.isin(ek, bkeys)
         if not hit.all():
-            e = np.asarray(edges).reshape(-1, 2)[np.flatnonzero(~hit)[0]]
+            e = np.asarray(part).reshape(-1, 2)[np.flatnonzero(~hit)[0]]
             raise InputError(f"edge {e.tolist()} of boundary {name!r} is not on the domain boundary")
         tags[np.isin(bkeys, ek)] = t
     if spacing is None:
-        spacing = _mean_edge_length(x, uniq, n)
+        spacing = _mean_edge_length(x, edges, n)
     spacing = np.ascontiguousarray(np.broadcast_to(np.asarray(spacing, float), (n,)))
-    return Particles(x, spacing, tri, bedges, tags, names)
+    return Particles(x, spacing, tri, bedges, tags, names, edges, tri_edges)
 
 
-def _mean_edge_length(x, edge_keys, n):
-    i, j = edge_keys // n, edge_keys % n
+def _mean_edge_length(x, edges, n):
+    i, j = edges[:, 0], edges[:, 1]
     length = np.linalg.norm(x[i] - x[j], axis=1)
     total = np.bincount(i, length, n) + np.bincount(j, length, n)
     count = np.bincount(i, minlength=n) + np.bincount(j, minlength=n)

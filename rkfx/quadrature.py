@@ -18,7 +18,7 @@ from .errors import InputError
 from .nodal_domains import NodalDomains
 from .particles import Particles
 from .shape_functions import RKApproximation, evaluate
-from .sparse_rows import SparseRows, combine_rows, stack_rows
+from .sparse_rows import SparseRows, combine_rows, difference_rows
 
 # Symmetric Gauss rules on the reference triangle: barycentric points and weights (sum 1).
 _TRIANGLE_RULES = {
@@ -76,32 +76,35 @@ def dni(p: Particles, rk: RKApproximation, domains: NodalDomains) -> Quadrature:
 
 @dataclass(frozen=True)
 class SmoothedGradients:
-    """Smoothed gradients of all shape functions on every nodal cell and subcell (eq. 3.55).
+    """Smoothed gradients of all shape functions on the nodal cells (eq. 3.55).
 
     Attributes:
         cell: Rows per node L: grad~N_I(x_L) [1/m].
-        subcell: Rows per subcell C: grad~N_I(x_hat_C), smoothed over C [1/m].
         node_values: Rows per node L: N_I(x_L).
+        cell_minus_subcell: Rows per subcell C of node L: grad~N_I(x_L) - grad~N_I(x_hat_C),
+            the subcell gradient smoothed over C (the MSCNI terms of eq. 3.56), or ``None``.
     """
 
     cell: SparseRows
-    subcell: SparseRows
     node_values: SparseRows
+    cell_minus_subcell: SparseRows | None
 
 
 def smoothed_gradients(p: Particles, rk: RKApproximation, domains: NodalDomains,
                        subcells: bool = True) -> SmoothedGradients:
-    """N at the smoothing points, combined into cell (and subcell) smoothed gradients."""
+    """N at the smoothing points, combined into cell smoothed gradients and, with ``subcells``,
+    the MSCNI differences (formed in one pass, without storing subcell gradients)."""
     d = domains
     at_points = evaluate(rk, d.smoothing_points)
     cell = combine_rows(at_points, d.cell_ptr, d.cell_point,
                         d.cell_normal_length / np.repeat(d.area, np.diff(d.cell_ptr))[:, None])
-    sub = None
+    diff = None
     if subcells:
         ns = len(d.subcell_area)
-        sub = combine_rows(at_points, np.arange(0, 4 * ns + 1, 4), d.subcell_point.ravel(),
-                           (d.subcell_normal_length / d.subcell_area[:, None, None]).reshape(-1, 2))
-    return SmoothedGradients(cell, sub, evaluate(rk, p.x))
+        diff = combine_rows(at_points, np.arange(0, 4 * ns + 1, 4), d.subcell_point.ravel(),
+                            (-d.subcell_normal_length / d.subcell_area[:, None, None]).reshape(-1, 2),
+                            base=cell, base_row=d.subcell_node)
+    return SmoothedGradients(cell, evaluate(rk, p.x), diff)
 
 
 def scni(p: Particles, rk: RKApproximation, domains: NodalDomains,
@@ -121,19 +124,12 @@ def mscni_stabilization(p: Particles, rk: RKApproximation, domains: NodalDomains
     if not eps_p >= 0:
         raise InputError(f"eps_p = {eps_p!r} must be >= 0 (1 is the usual MSCNI choice)")
     d = domains
-    s = smoothed if smoothed is not None and smoothed.subcell is not None else \
+    s = smoothed if smoothed is not None and smoothed.cell_minus_subcell is not None else \
         smoothed_gradients(p, rk, d, subcells=True)
-    ns = len(d.subcell_area)
-    src = stack_rows(s.cell, s.subcell)
-    diff = combine_rows(src, np.arange(0, 2 * ns + 1, 2),
-                        np.column_stack([d.subcell_node, p.num_nodes + np.arange(ns)]).ravel(),
-                        np.tile([1.0, -1.0], ns))
+    diff = s.cell_minus_subcell
     values = None
     if with_values:
-        at_c = evaluate(rk, d.subcell_centroid)
-        values = combine_rows(stack_rows(s.node_values, at_c), np.arange(0, 2 * ns + 1, 2),
-                              np.column_stack([d.subcell_node, p.num_nodes + np.arange(ns)]).ravel(),
-                              np.tile([1.0, -1.0], ns))
+        values = difference_rows(s.node_values, d.subcell_node, evaluate(rk, d.subcell_centroid))
     return Quadrature(d.subcell_centroid, eps_p * d.subcell_area, values, diff, "mscni-stabilization")
 
 

@@ -11,7 +11,9 @@ import numba
 import numpy as np
 import scipy.sparse as sp
 
-CHUNK = 1024  # rows per parallel work item
+# Rows are split into this many parallel work items per thread; each item allocates one
+# node-sized marker array, so items must be few and large.
+ITEMS_PER_THREAD = 4
 
 
 @dataclass(frozen=True)
@@ -53,85 +55,152 @@ class SparseRows:
 
 
 @numba.njit(parallel=True, cache=True)
-def _combine(src_ptr, src_idx, src_data, term_ptr, term_row, term_w, num_cols, out_ptr, out_idx, out_data, fill):
+def _combine(src_ptr, src_idx, src_val, term_ptr, term_row, term_w, num_cols, nchunks,
+             base_ptr, base_idx, base_data, base_row, out_ptr, out_idx, out_data, fill):
+    """Row r = base[base_row[r]] + sum_t w_t (vector) * src[term_row[t]] (scalar rows), via a
+    sparse accumulator; no base when ``base_row`` is empty."""
     nrows = len(term_ptr) - 1
-    nc_src = src_data.shape[1]
-    nc_w = term_w.shape[1]
-    nc = max(nc_src, nc_w)
-    nchunks = (nrows + CHUNK - 1) // CHUNK
+    nc = term_w.shape[1]
+    has_base = len(base_row) > 0
+    chunk = (nrows + nchunks - 1) // nchunks
     for c in numba.prange(nchunks):
         marker = np.full(num_cols, -1, np.int64)
-        for r in range(c * CHUNK, min(nrows, (c + 1) * CHUNK)):
+        for r in range(c * chunk, min(nrows, (c + 1) * chunk)):
             base = out_ptr[r] if fill else 0
             k = 0
+            if has_base:
+                rb = base_row[r]
+                for q in range(base_ptr[rb], base_ptr[rb + 1]):
+                    marker[base_idx[q]] = base + k
+                    if fill:
+                        out_idx[base + k] = base_idx[q]
+                        for d in range(nc):
+                            out_data[base + k, d] = base_data[q, d]
+                    k += 1
             for t in range(term_ptr[r], term_ptr[r + 1]):
                 s = term_row[t]
                 for q in range(src_ptr[s], src_ptr[s + 1]):
                     j = src_idx[q]
-                    if marker[j] < 0:
-                        marker[j] = base + k
-                        if fill:
-                            out_idx[base + k] = j
-                            for d in range(nc):
-                                out_data[base + k, d] = 0.0
+                    pos = marker[j]
+                    if pos < 0:
+                        pos = base + k
+                        marker[j] = pos
                         k += 1
+                        if fill:
+                            out_idx[pos] = j
+                            for d in range(nc):
+                                out_data[pos, d] = 0.0
                     if fill:
-                        pos = marker[j]
+                        v = src_val[q]
                         for d in range(nc):
-                            out_data[pos, d] += src_data[q, d if nc_src > 1 else 0] * term_w[t, d if nc_w > 1 else 0]
-            if fill:
-                # Reset markers of this row for the next rows of the chunk.
-                for q in range(base, base + k):
-                    marker[out_idx[q]] = -1
-            else:
+                            out_data[pos, d] += v * term_w[t, d]
+            if not fill:
                 out_ptr[r + 1] = k
-                for t in range(term_ptr[r], term_ptr[r + 1]):
-                    s = term_row[t]
-                    for q in range(src_ptr[s], src_ptr[s + 1]):
-                        marker[src_idx[q]] = -1
+            # Reset the markers this row set.
+            if has_base:
+                rb = base_row[r]
+                for q in range(base_ptr[rb], base_ptr[rb + 1]):
+                    marker[base_idx[q]] = -1
+            for t in range(term_ptr[r], term_ptr[r + 1]):
+                s = term_row[t]
+                for q in range(src_ptr[s], src_ptr[s + 1]):
+                    marker[src_idx[q]] = -1
+
+
+def _work_items(nrows: int) -> int:
+    return max(1, min(nrows, ITEMS_PER_THREAD * numba.get_num_threads()))
 
 
 def combine_rows(source: SparseRows, term_ptr: np.ndarray, term_row: np.ndarray,
-                 term_weight: np.ndarray) -> SparseRows:
-    """Rows formed as weighted sums of source rows.
+                 term_weight: np.ndarray, base: SparseRows | None = None,
+                 base_row: np.ndarray | None = None) -> SparseRows:
+    """Rows formed as weighted sums of scalar source rows, optionally added to base rows.
 
-    Output row r is ``sum_t w_t * source[term_row[t]]`` for t in ``term_ptr[r]:term_ptr[r+1]``,
-    with duplicate columns merged. Weights of shape ``(num_terms, c)`` times scalar source rows
-    give c-vector rows (e.g. N times n*l gives a gradient); scalar weights times c-vector
-    source rows scale them (e.g. differences of gradients).
+    Output row r is ``base[base_row[r]] + sum_t w_t * source[term_row[t]]`` for t in
+    ``term_ptr[r]:term_ptr[r+1]``, with duplicate columns merged; vector weights of shape
+    ``(num_terms, c)`` give c-vector rows (e.g. N times n*l gives a smoothed gradient, eq. 3.55).
 
     Args:
-        source: Rows to combine.
+        source: Rows with one component.
         term_ptr: Shape ``(num_out_rows + 1,)``.
         term_row: Source row of each term, shape ``(num_terms,)``.
         term_weight: Shape ``(num_terms,)`` or ``(num_terms, c)``.
+        base: Rows with c components added to the output, selected by ``base_row``.
+        base_row: Base row of each output row, shape ``(num_out_rows,)``.
     """
     w = np.ascontiguousarray(term_weight, dtype=np.float64)
     if w.ndim == 1:
         w = w[:, None]
     term_ptr = np.ascontiguousarray(term_ptr, dtype=np.int64)
     term_row = np.ascontiguousarray(term_row, dtype=np.int64)
-    nc = max(source.num_components, w.shape[1])
     nrows = len(term_ptr) - 1
     out_ptr = np.zeros(nrows + 1, np.int64)
-    dummy_i = np.empty(0, np.int32)
-    dummy_d = np.empty((0, nc))
-    args = (source.indptr, source.indices, np.ascontiguousarray(source.data), term_ptr, term_row, w,
-            source.num_cols)
-    _combine(*args, out_ptr, dummy_i, dummy_d, False)
+    if base is None:
+        base_args = (np.zeros(1, np.int64), np.empty(0, np.int32), np.empty((0, w.shape[1])), np.empty(0, np.int64))
+    else:
+        base_args = (base.indptr, base.indices, np.ascontiguousarray(base.data),
+                     np.ascontiguousarray(base_row, dtype=np.int64))
+    args = (source.indptr, source.indices, np.ascontiguousarray(source.data[:, 0]), term_ptr, term_row, w,
+            source.num_cols, _work_items(nrows), *base_args)
+    _combine(*args, out_ptr, np.empty(0, np.int32), np.empty((0, w.shape[1])), False)
     np.cumsum(out_ptr, out=out_ptr)
     out_idx = np.empty(out_ptr[-1], np.int32)
-    out_data = np.empty((out_ptr[-1], nc))
+    out_data = np.empty((out_ptr[-1], w.shape[1]))
     _combine(*args, out_ptr, out_idx, out_data, True)
     return SparseRows(out_ptr, out_idx, out_data, source.num_cols)
 
 
-def stack_rows(*blocks: SparseRows) -> SparseRows:
-    """Concatenate row blocks with equal columns and components."""
-    ptrs = [blocks[0].indptr]
-    offset = blocks[0].indptr[-1]
-    for b in blocks[1:]:
-        ptrs.append(b.indptr[1:] + offset)
-        offset += b.indptr[-1]
-    return SparseRows(np.concatenate(ptrs), np.concatenate([b.indices for b in blocks]),
-                      np.concatenate([b.data for b in blocks]), blocks[0].num_cols)
+@numba.njit(parallel=True, cache=True)
+def _difference(a_ptr, a_idx, a_data, a_row, b_ptr, b_idx, b_data, num_cols, nchunks,
+                out_ptr, out_idx, out_data, fill):
+    """Row r = a[a_row[r]] - b[r]."""
+    nrows = len(a_row)
+    nc = a_data.shape[1]
+    chunk = (nrows + nchunks - 1) // nchunks
+    for c in numba.prange(nchunks):
+        marker = np.full(num_cols, -1, np.int64)
+        for r in range(c * chunk, min(nrows, (c + 1) * chunk)):
+            base = out_ptr[r] if fill else 0
+            k = 0
+            ra = a_row[r]
+            for q in range(a_ptr[ra], a_ptr[ra + 1]):
+                j = a_idx[q]
+                marker[j] = base + k
+                if fill:
+                    out_idx[base + k] = j
+                    for d in range(nc):
+                        out_data[base + k, d] = a_data[q, d]
+                k += 1
+            for q in range(b_ptr[r], b_ptr[r + 1]):
+                j = b_idx[q]
+                pos = marker[j]
+                if pos < 0:
+                    pos = base + k
+                    k += 1
+                    if fill:
+                        out_idx[pos] = j
+                        for d in range(nc):
+                            out_data[pos, d] = -b_data[q, d]
+                elif fill:
+                    for d in range(nc):
+                        out_data[pos, d] -= b_data[q, d]
+            if not fill:
+                out_ptr[r + 1] = k
+            for q in range(a_ptr[ra], a_ptr[ra + 1]):
+                marker[a_idx[q]] = -1
+
+
+def difference_rows(a: SparseRows, a_row: np.ndarray, b: SparseRows) -> SparseRows:
+    """Rows ``a[a_row[r]] - b[r]`` (same columns and components), e.g. the MSCNI terms of eq. (3.56)."""
+    a_row = np.ascontiguousarray(a_row, dtype=np.int64)
+    nrows = len(a_row)
+    out_ptr = np.zeros(nrows + 1, np.int64)
+    nc = a.num_components
+    args = (a.indptr, a.indices, np.ascontiguousarray(a.data), a_row, b.indptr, b.indices,
+            np.ascontiguousarray(b.data), a.num_cols, _work_items(nrows))
+    _difference(*args, out_ptr, np.empty(0, np.int32), np.empty((0, nc)), False)
+    np.cumsum(out_ptr, out=out_ptr)
+    out_idx = np.empty(out_ptr[-1], np.int32)
+    out_data = np.empty((out_ptr[-1], nc))
+    _difference(*args, out_ptr, out_idx, out_data, True)
+    return SparseRows(out_ptr, out_idx, out_data, a.num_cols)
