@@ -46,7 +46,7 @@ class ElasticSolution:
 def solve_plane_strain(p: Particles, material: ElasticMaterial, dirichlet: Sequence[Dirichlet],
                        tractions: Sequence[Traction] = (),
                        body_force: Callable[[np.ndarray], np.ndarray] | None = None,
-                       rule: str = "mscni", bc_method: str = "transformation", support_factor: float = 1.5,
+                       rule: str = "mscni", bc_method: str = "nitsche", support_factor: float = 1.5,
                        order: int = 1, nitsche_penalty: float = 100.0, comm=None,
                        solver: str = "mumps") -> ElasticSolution:
     """Solve plane-strain elasticity on ``p``.

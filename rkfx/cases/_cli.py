@@ -1,0 +1,269 @@
+"""The command-line interface every case shares: parameters, results file, summary table.
+
+    python -m rkfx.cases.<name> [--quick] [--method rkpm|fem|both] [--set NAME=VALUE ...] [--out DIR]
+
+A case declares its parameters as ``{name: Param(default, doc)}``; ``--set`` values are
+coerced to the default's type (float, int, str, bool; comma-separated lists for list
+defaults). ``--quick`` first applies the case's coarse settings, then ``--set`` overrides.
+Bad parameters and the case's own input errors (``rkfx.errors.InputError``) end the program
+with a one-line message on stderr and exit code 2, never a traceback.
+
+Results go to ``DIR/results.json`` (default ``results/<name>/``) with the schema
+
+    {"case": str, "params": {...},
+     "runs": [{"method": str, "wall_time_s": float, "n_dofs": int,
+               "series": {...}, "errors": {...}, "info": {...}}]}
+
+(numpy arrays become lists; non-finite floats become null).
+"""
+import argparse
+import json
+import math
+import sys
+import textwrap
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+
+METHODS = {"rkpm": ("rkpm",), "fem": ("fem",), "both": ("rkpm", "fem")}
+
+
+@dataclass(frozen=True)
+class Param:
+    """A documented case parameter: its default (which fixes its type) and a one-line doc."""
+
+    default: Any
+    doc: str
+
+
+@dataclass
+class Run:
+    """One solve of a case by one method.
+
+    Attributes:
+        method: Method label, e.g. ``rkpm-mscni`` or ``fem-p2``.
+        wall_time_s: Wall time of the solve [s].
+        n_dofs: Number of unknowns.
+        series: Named arrays (curves, fields) for plots.
+        errors: Named scalar errors (and rates) against the exact solution.
+        info: Named scalars that identify the run (mesh size, level, ...).
+    """
+
+    method: str
+    wall_time_s: float
+    n_dofs: int
+    series: dict[str, Any] = field(default_factory=dict)
+    errors: dict[str, float] = field(default_factory=dict)
+    info: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass
+class Results:
+    """What a case's ``run`` returns: its name, the parameters used and the runs."""
+
+    case: str
+    params: dict[str, Any]
+    runs: list[Run] = field(default_factory=list)
+
+
+class ParameterError(InputError):
+    """A ``--set`` override names no parameter or cannot be read as the parameter's type."""
+
+
+def coerce(name: str, text: str, default: Any) -> Any:
+    """``text`` read as the type of ``default`` (lists: comma-separated, typed by their first item)."""
+    if isinstance(default, (list, tuple)):
+        kind = default[0] if default else ""
+        items = [t.strip() for t in text.split(",") if t.strip()]
+        if not items:
+            raise ParameterError(f"{name}: expected a comma-separated list, got {text!r}")
+        return [coerce(name, t, kind) for t in items]
+    if isinstance(default, bool):
+        low = text.strip().lower()
+        if low in ("1", "true", "yes", "on"):
+            return True
+        if low in ("0", "false", "no", "off"):
+            return False
+        raise ParameterError(f"{name}: expected true or false, got {text!r}")
+    if isinstance(default, int):
+        try:
+            return int(text)
+        except ValueError:
+            raise ParameterError(f"{name}: expected an integer, got {text!r}") from None
+    if isinstance(default, float):
+        try:
+            value = float(text)
+        except ValueError:
+            raise ParameterError(f"{name}: expected a number, got {text!r}") from None
+        if not math.isfinite(value):
+            raise ParameterError(f"{name}: expected a finite number, got {text!r}")
+        return value
+    return text
+
+
+def parse_params(specs: Mapping[str, Param], overrides: Sequence[str] = (),
+                 base: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """Defaults of ``specs``, then ``base`` (e.g. quick settings), then ``NAME=VALUE`` overrides."""
+    params = {k: v.default for k, v in specs.items()}
+    params.update(base or {})
+    valid = ", ".join(specs)
+    for item in overrides:
+        name, sep, text = item.partition("=")
+        name = name.strip()
+        if not sep:
+            raise ParameterError(f"--set {item!r}: expected NAME=VALUE; valid names: {valid}")
+        if name not in specs:
+            raise ParameterError(f"unknown parameter {name!r}; valid names: {valid}")
+        params[name] = coerce(name, text, specs[name].default)
+    return params
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (no usage dump), exit code 2."""
+
+    def error(self, message):
+        _fail(self.prog, f"{message} (see --help)")
+
+
+def _fail(prog: str, message: str):
+    if _rank() == 0:
+        print(f"{prog}: error: {' '.join(str(message).split())}", file=sys.stderr)
+    raise SystemExit(2)
+
+
+def _rank() -> int:
+    # Without importing mpi4py here: dolfinx_solver must load MPI first.
+    mpi = sys.modules.get("mpi4py.MPI")
+    return mpi.COMM_WORLD.rank if mpi is not None else 0
+
+
+def build_parser(name: str, doc: str | None, specs: Mapping[str, Param],
+                 quick: Mapping[str, Any] | None = None) -> argparse.ArgumentParser:
+    """The shared parser; ``--help`` lists the parameters with defaults and docs."""
+    lines = ["parameters (--set NAME=VALUE):"]
+    width = max(len(k) for k in specs) if specs else 0
+    for k, v in specs.items():
+        default = ",".join(map(str, v.default)) if isinstance(v.default, (list, tuple)) else v.default
+        lines.append(f"  {k:<{width}}  {v.doc} (default {default})")
+    if quick:
+        lines.append("--quick sets " + ", ".join(f"{k}={_fmt_value(v)}" for k, v in quick.items()))
+    summary = (doc or "").strip().split("\n\n")[0]
+    parser = _Parser(prog=f"python -m rkfx.cases.{name}", description=summary, epilog="\n".join(lines),
+                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--quick", action="store_true", help="coarse settings for a fast check")
+    parser.add_argument("--method", choices=list(METHODS), default="both", help="methods to run (default both)")
+    parser.add_argument("--set", dest="overrides", action="extend", nargs="+", default=[], metavar="NAME=VALUE",
+                        help="override parameters (--set a=1 b=2 or --set a=1 --set b=2)")
+    parser.add_argument("--out", type=Path, default=Path("results") / name,
+                        help=f"output directory (default results/{name}/)")
+    return parser
+
+
+def _fmt_value(v):
+    return ",".join(map(str, v)) if isinstance(v, (list, tuple)) else str(v)
+
+
+def main(name: str, doc: str | None, specs: Mapping[str, Param], run: Callable[..., Results],
+         plot: Callable[[Results, Path], Sequence[Path]] | None = None, argv: Sequence[str] | None = None,
+         quick: Mapping[str, Any] | None = None) -> int:
+    """Parse ``argv``, call ``run(methods=..., **params)``, write results.json, plot, print the table.
+
+    Returns:
+        0 on success. Bad parameters and ``InputError`` raise ``SystemExit(2)`` after a one-line
+        message on stderr.
+    """
+    parser = build_parser(name, doc, specs, quick)
+    args = parser.parse_args(argv)
+    try:
+        params = parse_params(specs, args.overrides, quick if args.quick else None)
+        results = run(methods=METHODS[args.method], **params)
+    except InputError as err:
+        _fail(parser.prog, err)
+    if _rank() != 0:
+        return 0
+    path = write_results(results, args.out)
+    figures = list(plot(results, args.out)) if plot is not None else []
+    print(summary_table(results))
+    print(f"\nresults: {path}")
+    for f in figures:
+        print(f"figure:  {f}")
+    return 0
+
+
+def jsonable(obj: Any) -> Any:
+    """Plain JSON data: arrays to lists, numpy scalars to Python, non-finite floats to None."""
+    if isinstance(obj, Mapping):
+        return {str(k): jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, np.ndarray):
+        return jsonable(obj.tolist())
+    if isinstance(obj, (list, tuple)):
+        return [jsonable(v) for v in obj]
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, (int, np.integer)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        return float(obj) if math.isfinite(obj) else None
+    if isinstance(obj, Path):
+        return str(obj)
+    return obj
+
+
+def write_results(results: Results, out: Path) -> Path:
+    """Write ``out/results.json`` (creating ``out``); returns its path."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    data = {"case": results.case, "params": results.params,
+            "runs": [{"method": r.method, "wall_time_s": r.wall_time_s, "n_dofs": r.n_dofs,
+                      "series": r.series, "errors": r.errors, "info": r.info} for r in results.runs]}
+    path = out / "results.json"
+    path.write_text(json.dumps(jsonable(data), indent=1, allow_nan=False) + "\n")
+    return path
+
+
+def summary_table(results: Results) -> str:
+    """Plain-text table: method, info scalars, dofs, wall time, errors."""
+    def keys(attr):
+        seen = {}
+        for r in results.runs:
+            for k, v in getattr(r, attr).items():
+                if np.ndim(v) == 0:
+                    seen.setdefault(k, None)
+        return list(seen)
+
+    info, errs = keys("info"), keys("errors")
+    head = ["method", *info, "dofs", "wall [s]", *errs]
+    rows = [[r.method, *(_cell(r.info.get(k)) for k in info), str(r.n_dofs), f"{r.wall_time_s:.2f}",
+             *(_cell(r.errors.get(k)) for k in errs)] for r in results.runs]
+    widths = [max(len(c) for c in col) for col in zip(head, *rows)]
+    fmt = lambda row: "  ".join(c.rjust(w) if i else c.ljust(w) for i, (c, w) in enumerate(zip(row, widths)))  # noqa: E731
+    title = f"{results.case}: " + ", ".join(f"{k}={_fmt_value(v)}" for k, v in results.params.items())
+    return "\n".join([textwrap.shorten(title, 200), fmt(head), "  ".join("-" * w for w in widths),
+                      *map(fmt, rows)])
+
+
+def _cell(v) -> str:
+    if v is None:
+        return "-"
+    if isinstance(v, (bool, np.bool_, str)):
+        return str(v)
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    v = float(v)
+    return "-" if not math.isfinite(v) else f"{v:.3g}"
+
+
+def progress(iterable: Iterable, desc: str = "", total: int | None = None) -> Iterable:
+    """tqdm progress bar on stderr when it is a terminal; the bare iterable otherwise."""
+    if not sys.stderr.isatty() or _rank() != 0:
+        return iterable
+    try:
+        from tqdm import tqdm  # noqa: PLC0415
+    except ImportError:
+        return iterable
+    return tqdm(iterable, desc=desc, total=total, leave=False)
