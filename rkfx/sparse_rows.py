@@ -57,23 +57,29 @@ class SparseRows:
 @numba.njit(parallel=True, cache=True)
 def _combine(src_ptr, src_idx, src_val, term_ptr, term_row, term_w, num_cols, nchunks,
              base_ptr, base_idx, base_data, base_row, out_ptr, out_idx, out_data, fill):
-    """Row r = base[base_row[r]] + sum_t w_t (vector) * src[term_row[t]] (scalar rows), via a
-    sparse accumulator; no base when ``base_row`` is empty."""
+    """Row r = base[base_row[r]] + sum_t w_t (vector) * src[term_row[t]] (scalar rows).
+
+    Sparse accumulator with row stamps: ``stamp[j] == r`` marks column j as present in row r
+    at local position ``slot[j]``, so nothing needs resetting between rows.
+    """
     nrows = len(term_ptr) - 1
     nc = term_w.shape[1]
     has_base = len(base_row) > 0
     chunk = (nrows + nchunks - 1) // nchunks
     for c in numba.prange(nchunks):
-        marker = np.full(num_cols, -1, np.int64)
+        stamp = np.full(num_cols, -1, np.int64)
+        slot = np.empty(num_cols, np.int32)
         for r in range(c * chunk, min(nrows, (c + 1) * chunk)):
             base = out_ptr[r] if fill else 0
             k = 0
             if has_base:
                 rb = base_row[r]
                 for q in range(base_ptr[rb], base_ptr[rb + 1]):
-                    marker[base_idx[q]] = base + k
+                    j = base_idx[q]
+                    stamp[j] = r
+                    slot[j] = k
                     if fill:
-                        out_idx[base + k] = base_idx[q]
+                        out_idx[base + k] = j
                         for d in range(nc):
                             out_data[base + k, d] = base_data[q, d]
                     k += 1
@@ -81,30 +87,21 @@ def _combine(src_ptr, src_idx, src_val, term_ptr, term_row, term_w, num_cols, nc
                 s = term_row[t]
                 for q in range(src_ptr[s], src_ptr[s + 1]):
                     j = src_idx[q]
-                    pos = marker[j]
-                    if pos < 0:
-                        pos = base + k
-                        marker[j] = pos
-                        k += 1
+                    if stamp[j] != r:
+                        stamp[j] = r
+                        slot[j] = k
                         if fill:
-                            out_idx[pos] = j
+                            out_idx[base + k] = j
                             for d in range(nc):
-                                out_data[pos, d] = 0.0
+                                out_data[base + k, d] = 0.0
+                        k += 1
                     if fill:
+                        pos = base + slot[j]
                         v = src_val[q]
                         for d in range(nc):
                             out_data[pos, d] += v * term_w[t, d]
             if not fill:
                 out_ptr[r + 1] = k
-            # Reset the markers this row set.
-            if has_base:
-                rb = base_row[r]
-                for q in range(base_ptr[rb], base_ptr[rb + 1]):
-                    marker[base_idx[q]] = -1
-            for t in range(term_ptr[r], term_ptr[r + 1]):
-                s = term_row[t]
-                for q in range(src_ptr[s], src_ptr[s + 1]):
-                    marker[src_idx[q]] = -1
 
 
 def _work_items(nrows: int) -> int:
