@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from ..warmup import warm_up
 
 METHODS = {"rkpm": ("rkpm",), "fem": ("fem",), "both": ("rkpm", "fem")}
 
@@ -181,6 +182,7 @@ def main(name: str, doc: str | None, specs: Mapping[str, Param], run: Callable[.
     args = parser.parse_args(argv)
     try:
         params = parse_params(specs, args.overrides, quick if args.quick else None)
+        warm_up()  # wall times below measure the methods, not the JIT compiler
         results = run(methods=METHODS[args.method], **params)
     except InputError as err:
         _fail(parser.prog, err)

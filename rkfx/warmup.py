@@ -1,0 +1,27 @@
+"""Compile (or load from numba's cache) every kernel of the core on a tiny problem.
+
+Benchmarks and cases call ``warm_up()`` before timing so that reported wall times measure
+the method, not the just-in-time compiler (about 20 s on a fresh install, well under a
+second afterwards).
+"""
+from functools import cache
+
+
+@cache
+def warm_up() -> None:
+    from .elasticity import ElasticMaterial
+    from .nodal_domains import nodal_domains
+    from .operators import stiffness
+    from .particles import structured
+    from .quadrature import integration_rules, mscni_stabilization, smoothed_gradients
+    from .shape_functions import evaluate, rk_approximation
+
+    p = structured(1.0, 1.0, 5, 5)
+    d = nodal_domains(p)
+    for order, c in ((1, 1.5), (2, 2.5)):
+        rk = rk_approximation(p.x, p.spacing, c, order)
+        evaluate(rk, p.x, gradients=True)
+    rk = rk_approximation(p.x, p.spacing)
+    s = smoothed_gradients(p, rk, d)
+    mscni_stabilization(p, rk, d, s, with_values=True)
+    stiffness(integration_rules("dni", p, rk, d), ElasticMaterial(1.0, 0.3).D())
