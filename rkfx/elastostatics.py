@@ -9,6 +9,7 @@ import scipy.sparse as sp
 from .boundary import (BC_METHODS, Dirichlet, Traction, boundary_quadrature, nitsche_terms, traction_load,
                        transformation_constraints)
 from .elasticity import ElasticMaterial
+from .linear_solver import linear_solver
 from .errors import InputError
 from .nodal_domains import nodal_domains
 from .operators import load_vector, stiffness
@@ -88,7 +89,9 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, dirichlet: Seque
     else:
         system = sp.bmat([[k, g.T], [g, None]], format="csr")
         rhs = np.concatenate([f, gv])
-    x = _linear_solve(system, rhs, comm, solver)
+    ls = linear_solver(system, comm, solver)
+    x = ls.solve(rhs)
+    ls.destroy()
     times["solve"] = time.perf_counter() - t0
     return ElasticSolution(rk, x[:2 * p.num_nodes].reshape(-1, 2), 2 * p.num_nodes, times)
 
@@ -112,14 +115,3 @@ def _check_rigid_modes(p: Particles, g: sp.csr_matrix) -> None:
                 if not np.any(np.abs(seen[:, k]) > 1e-12 * scale)] or ["a combination of rigid motions"]
         raise InputError(f"the displacement conditions leave {', '.join(free)} free, so the stiffness is "
                          "singular; prescribe more components (e.g. a roller on a second boundary)")
-
-
-def _linear_solve(a, b, comm, solver):
-    try:
-        from . import petsc  # noqa: PLC0415
-    except ImportError:
-        if solver != "mumps":
-            raise InputError(f"solver {solver!r} needs PETSc: pip install 'rkfx[fem]'") from None
-        import scipy.sparse.linalg as spla  # noqa: PLC0415
-        return spla.spsolve(a.tocsc(), b)
-    return petsc.solve(a, b, comm if comm is not None else petsc.MPI.COMM_WORLD, solver)

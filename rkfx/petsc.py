@@ -87,39 +87,63 @@ def make_ksp(mat: PETSc.Mat, solver: str = "mumps", rtol: float = 1e-12, prefix:
     return ksp
 
 
+class LinearSolver:
+    """A factorized (or preconditioned) system ``a x = b`` reused for many right-hand sides.
+
+    Time-stepping loops keep one per distinct matrix (e.g. per time-step size), so MUMPS
+    factorizes once. Every solve is checked: null pivots, divergence and a large residual
+    raise ``SolverDiverged``.
+    """
+
+    def __init__(self, a: sp.spmatrix, comm=MPI.COMM_WORLD, solver: str = "mumps"):
+        self.solver = solver
+        self.mat = to_petsc_mat(a, comm)
+        self.ksp = make_ksp(self.mat, solver)
+        self.rhs = self.mat.createVecLeft()
+        self.x = self.mat.createVecRight()
+        self.residual = self.mat.createVecLeft()
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """The whole solution on every rank."""
+        lo, hi = self.rhs.getOwnershipRange()
+        self.rhs.array[:] = np.asarray(b, dtype=PETSc.ScalarType)[lo:hi]
+        try:
+            self.ksp.solve(self.rhs, self.x)
+        except PETSc.Error as err:
+            raise SolverDiverged(f"PETSc solver {self.solver!r} failed ({err}); the system may be singular: "
+                                 "check that essential boundary conditions remove all rigid-body modes") from None
+        if self.solver == "mumps":
+            null_pivots = self.ksp.getPC().getFactorMatrix().getMumpsInfog(28)
+            if null_pivots > 0:
+                raise SolverDiverged(f"the system matrix is singular ({null_pivots} null pivots): essential "
+                                     "boundary conditions must remove all rigid-body modes")
+        reason = self.ksp.getConvergedReason()
+        if reason < 0:
+            raise SolverDiverged(f"PETSc solver {self.solver!r} diverged (KSPConvergedReason {reason}) after "
+                                 f"{self.ksp.getIterationNumber()} iterations; try solver='mumps' or check the "
+                                 "boundary conditions")
+        self.mat.mult(self.x, self.residual)
+        self.residual.axpy(-1.0, self.rhs)
+        scale = max(self.rhs.norm(), 1e-300)
+        if self.residual.norm() > 1e-6 * scale:
+            raise SolverDiverged(f"PETSc solver {self.solver!r} left a relative residual of "
+                                 f"{self.residual.norm() / scale:.2e}: the system is singular or "
+                                 "ill-conditioned; check the boundary conditions")
+        return gather(self.x)
+
+    def destroy(self) -> None:
+        for obj in (self.ksp, self.mat, self.rhs, self.x, self.residual):
+            obj.destroy()
+
+
 def solve(a: sp.spmatrix, b: np.ndarray, comm=MPI.COMM_WORLD, solver: str = "mumps") -> np.ndarray:
     """Solve ``a x = b`` through PETSc; returns the whole solution on every rank.
 
     Raises:
         SolverDiverged: Naming PETSc's reason and what to try instead.
     """
-    mat = to_petsc_mat(a, comm)
-    rhs = to_petsc_vec(b, mat)
-    x = mat.createVecRight()
-    ksp = make_ksp(mat, solver)
+    ls = LinearSolver(a, comm, solver)
     try:
-        ksp.solve(rhs, x)
-    except PETSc.Error as err:
-        raise SolverDiverged(f"PETSc solver {solver!r} failed ({err}); the system may be singular: "
-                             "check that essential boundary conditions remove all rigid-body modes") from None
-    reason = ksp.getConvergedReason()
-    if solver == "mumps":
-        null_pivots = ksp.getPC().getFactorMatrix().getMumpsInfog(28)
-        if null_pivots > 0:
-            raise SolverDiverged(f"the system matrix is singular ({null_pivots} null pivots): essential "
-                                 "boundary conditions must remove all rigid-body modes")
-    if reason < 0:
-        raise SolverDiverged(f"PETSc solver {solver!r} diverged (KSPConvergedReason {reason}) after "
-                             f"{ksp.getIterationNumber()} iterations; try solver='mumps' or check the "
-                             "boundary conditions")
-    residual = mat.createVecLeft()
-    mat.mult(x, residual)
-    residual.axpy(-1.0, rhs)
-    if residual.norm() > 1e-6 * max(rhs.norm(), 1e-300):
-        raise SolverDiverged(f"PETSc solver {solver!r} left a relative residual of "
-                             f"{residual.norm() / max(rhs.norm(), 1e-300):.2e}: the system is singular or "
-                             "ill-conditioned; check the boundary conditions")
-    out = gather(x)
-    for obj in (ksp, mat, rhs, x, residual):
-        obj.destroy()
-    return out
+        return ls.solve(b)
+    finally:
+        ls.destroy()
