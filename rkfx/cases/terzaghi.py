@@ -1,0 +1,265 @@
+"""Terzaghi's consolidation: RKPM u-p variants and dolfinx FEM against the exact series (seed 3.4.1).
+
+Problem. A soil layer of height H under a load q applied suddenly at t = 0+ on its drained top;
+the bottom is fixed and impermeable, the sides are rollers and impermeable, so the response is
+one-dimensional. Modelled as a W x H column:
+
+    top    (y = H)   total traction (0, -q), drained p = 0
+    bottom (y = 0)   u = 0, no flow
+    left, right      u_x = 0, no flow
+
+The load is carried at first by the pore fluid (p = p0 = alpha q / (alpha^2 + S K_v)); the
+pressure then diffuses out through the top with the consolidation coefficient
+c_v = k K_v / (alpha^2 + S K_v). Exact solution: ``verification.terzaghi`` (Fourier series,
+erfc series at early times).
+
+Seed set-up (Fig 3.4-3.6): W = 3 m, H = 10 m, 7 x 21 nodes, Delta t = 1 s, E = 1 kPa, nu = 0,
+k_h = 1e-5 m/s and gamma_f = 10 kN/m^3, so k = k_h / gamma_f = 1e-9 m^2/(Pa s); c_v = 1e-6 m^2/s,
+so after the first step the layer is still undrained except for a thin boundary layer at the
+top, the regime in which equal-order u-p approximations oscillate.
+
+Studies:
+
+* variants — pressure along the column axis at the output times (the first step and
+  ``t_end``; more with ``t_out``), for every RKPM variant and FEM element. After the first
+  step: deviation from the exact profile away from the drained layer (more than
+  ``2 H / (ny - 1)`` below the top) and the overshoot max p / p0 - 1.
+* refinement — the first-step profile near the drained top with ``refine_ny`` nodes along the
+  height (seed: 21, 41, 81), for ``scni+fpp`` and Taylor-Hood; relative L2 error of p along
+  the axis per level.
+
+Parameters and units (``--set NAME=VALUE``): E [Pa], nu [-], k [m^2/(Pa s)], alpha [-],
+S [1/Pa], W [m], H [m], q [Pa], nx, ny, dt [s], t_end [s], t_out (list [s]), growth [-],
+variants (list), fem (list), refine_ny (list), support_factor [-].
+
+    python -m rkfx.cases.terzaghi [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
+"""
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from verification.terzaghi import Terzaghi
+
+from ..errors import InputError
+from ..particles import structured
+from ..poroelasticity import (VARIANTS, Displacement, PoroMaterial, Pressure, TotalTraction, solve_biot,
+                              time_grid, zero)
+from . import _cli
+from ._cli import Param, Results, Run
+
+NAME = "terzaghi"
+FEM_ELEMENTS = ("taylor-hood", "q1q1", "q1q1-fpp")
+NUM_SAMPLES = 501
+HOLD = 10
+
+PARAMS = {
+    "E": Param(1.0e3, "drained Young's modulus [Pa]"),
+    "nu": Param(0.0, "drained Poisson's ratio [-]"),
+    "k": Param(1.0e-9, "mobility k_h / gamma_f [m^2/(Pa s)]"),
+    "alpha": Param(1.0, "Biot coefficient [-]"),
+    "S": Param(0.0, "storage coefficient 1/Q [1/Pa] (0: incompressible constituents)"),
+    "W": Param(3.0, "width of the column [m]"),
+    "H": Param(10.0, "height of the layer [m]"),
+    "q": Param(1.0e3, "load on the top [Pa]"),
+    "nx": Param(7, "nodes across the width"),
+    "ny": Param(21, "nodes along the height"),
+    "dt": Param(1.0, "first time step [s]"),
+    "t_end": Param(1.0, "last output time [s] (always an output)"),
+    "t_out": Param([], "further output times [s]"),
+    "growth": Param(1.5, "step growth factor every 10 steps after the first [-]"),
+    "variants": Param(list(VARIANTS), "RKPM variants"),
+    "fem": Param(list(FEM_ELEMENTS), "FEM elements: taylor-hood, q1q1, q1q1-fpp"),
+    "refine_ny": Param([21, 41, 81], "nodes along the height of the refinement study"),
+    "support_factor": Param(1.5, "RK support radius / nodal spacing [-]"),
+}
+QUICK = {"refine_ny": [21, 41], "fem": ["taylor-hood", "q1q1-fpp"]}
+
+
+def _check(W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny):
+    for name, v in (("W", W), ("H", H), ("dt", dt)):
+        if not v > 0:
+            raise InputError(f"{name} = {v!r} must be positive")
+    if q == 0:
+        raise InputError("q = 0: the layer carries no load")
+    for name, v in [("nx", nx), ("ny", ny)] + [("refine_ny", v) for v in refine_ny]:
+        if v < 3:
+            raise InputError(f"{name} = {v}: need at least 3 nodes per direction")
+    if not t_end >= dt:
+        raise InputError(f"t_end = {t_end!r} must be >= dt = {dt!r} (the first step is always taken)")
+    if any(not 0 < t <= t_end for t in t_out):
+        raise InputError(f"t_out = {t_out!r}: output times must lie in (0, t_end]")
+    if not growth >= 1:
+        raise InputError(f"growth = {growth!r} must be >= 1")
+    for v in variants:
+        if v not in VARIANTS:
+            raise InputError(f"unknown RKPM variant {v!r}; choose from {', '.join(VARIANTS)}")
+    for e in fem:
+        if e not in FEM_ELEMENTS:
+            raise InputError(f"unknown FEM element {e!r}; choose from {', '.join(FEM_ELEMENTS)}")
+
+
+def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_factor):
+    """Pressure at the samples for each output time, wall time and unknowns."""
+    if method.startswith("rkpm-"):
+        p = structured(W, H, nx, ny)
+        sol = solve_biot(p, material, times, outputs,
+                         displacements=[Displacement("bottom", zero), Displacement("left", zero, (0,)),
+                                        Displacement("right", zero, (0,))],
+                         pressures=[Pressure("top", lambda x, t: np.zeros(len(x)))],
+                         tractions=[TotalTraction("top", lambda x, t, n: np.tile([0.0, -q], (len(x), 1)))],
+                         variant=method[5:], support_factor=support_factor,
+                         progress=lambda it: _cli.progress(it, method, len(times) - 1))
+        return sol.pressure(samples), sol.wall_time_s, sol.n_dofs
+    import dolfinx_solver  # noqa: F401, PLC0415
+
+    from fem_baselines import poroelasticity as fb  # noqa: PLC0415
+
+    element = method[4:]
+    mesh = fb.rectangle_mesh(np.linspace(0, W, nx), np.linspace(0, H, ny),
+                             "triangle" if element == "taylor-hood" else "quadrilateral")
+    bcs = [fb.Displacement("bottom", 0, 0.0), fb.Displacement("bottom", 1, 0.0), fb.Displacement("left", 0, 0.0),
+           fb.Displacement("right", 0, 0.0), fb.Traction("top", np.array([0.0, -q])), fb.Pressure("top", 0.0)]
+    res = fb.solve_biot(mesh, material.E, material.nu, material.k, material.alpha, material.S, element, bcs,
+                        times, samples, outputs)
+    return res.p, res.wall_time_s, res.n_dofs
+
+
+def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e3, nu=0.0, k=1.0e-9, alpha=1.0, S=0.0, W=3.0, H=10.0,
+        q=1.0e3, nx=7, ny=21, dt=1.0, t_end=1.0, t_out=(), growth=1.5, variants=VARIANTS, fem=FEM_ELEMENTS,
+        refine_ny=(21, 41, 81), support_factor=1.5) -> Results:
+    """Both studies for every requested method; see the module docstring."""
+    _check(W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny)
+    material = PoroMaterial(E, nu, k, alpha, S)
+    exact = Terzaghi(E, nu, k, H, q, alpha, S)
+    p0 = exact.p0
+    outputs = np.unique(np.r_[dt, np.asarray(t_out, float), t_end])
+    times = np.array([0.0, dt])
+    if t_end > dt:  # after the first step, steps grow towards the later outputs
+        times = np.r_[0.0, dt + time_grid(outputs[outputs > dt] - dt, dt * growth, growth, hold=HOLD)]
+        times[np.searchsorted(times, outputs - 1e-9 * outputs)] = outputs  # exact output times
+    z = np.linspace(0.0, H, NUM_SAMPLES)
+    samples = np.column_stack([np.full_like(z, 0.5 * W), z])
+    p_exact = np.array([exact.pressure(z, t) for t in outputs])
+    away = z < H - 2.0 * H / (ny - 1)
+    labels = ([f"rkpm-{v}" for v in variants] if "rkpm" in methods else []) + \
+             ([f"fem-{e}" for e in fem] if "fem" in methods else [])
+    results = Results(NAME, dict(E=E, nu=nu, k=k, alpha=alpha, S=S, W=W, H=H, q=q, nx=nx, ny=ny, dt=dt, t_end=t_end,
+                                 t_out=list(t_out), growth=growth, variants=list(variants), fem=list(fem),
+                                 refine_ny=list(refine_ny), support_factor=support_factor, p0=p0, c_v=exact.c_v,
+                                 steps=len(times) - 1))
+    for label in labels:
+        p_h, wall, dofs = _solve(label, W, H, nx, ny, material, q, times, outputs, samples, support_factor)
+        first = p_h[0] / p0
+        errors = {"first_step_max_dev_away": float(np.abs(first - p_exact[0] / p0)[away].max()),
+                  "first_step_overshoot": float(first.max() - 1.0),
+                  "first_step_l2": float(np.linalg.norm(p_h[0] - p_exact[0]) / np.linalg.norm(p_exact[0]))}
+        for t, ph, pe in zip(outputs[1:], p_h[1:], p_exact[1:]):
+            errors[f"l2_t{t:g}"] = float(np.linalg.norm(ph - pe) / np.linalg.norm(pe))
+        results.runs.append(Run(label, wall, dofs, series={"z": z, "t": outputs, "p": p_h, "p_exact": p_exact},
+                                errors=errors, info={"study": "variants", "nx": nx, "ny": ny}))
+    # Refinement near the drained top after the first step (Fig 3.6).
+    refine = [m for m in ("rkpm-scni+fpp", "fem-taylor-hood") if m.split("-")[0] in methods]
+    for label in refine:
+        for n in refine_ny:
+            mx = max(3, int(round((nx - 1) * (n - 1) / (ny - 1))) + 1)
+            p_h, wall, dofs = _solve(label, W, H, mx, n, material, q, np.array([0.0, dt]), [dt], samples,
+                                     support_factor)
+            results.runs.append(Run(f"{label} ny={n}", wall, dofs,
+                                    series={"z": z, "t": [dt], "p": p_h, "p_exact": p_exact[:1]},
+                                    errors={"first_step_l2": float(np.linalg.norm(p_h[0] - p_exact[0])
+                                                                   / np.linalg.norm(p_exact[0]))},
+                                    info={"study": "refinement", "nx": mx, "ny": n}))
+    return results
+
+
+def plot(results: Results, out: Path) -> list[Path]:
+    """First-step profiles of every method (Fig 3.5), later profiles, and the refinement (Fig 3.6)."""
+    import matplotlib  # noqa: PLC0415
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    prm = results.params
+    H, p0 = prm["H"], prm["p0"]
+    files = []
+    runs = [r for r in results.runs if r.info["study"] == "variants"]
+    styles = {"ni": ("tab:red", "-"), "scni": ("tab:orange", "-"), "ni+fpp": ("tab:purple", "--"),
+              "scni+fpp": ("tab:blue", "-"), "taylor-hood": ("tab:green", ":"), "q1q1": ("tab:brown", ":"),
+              "q1q1-fpp": ("tab:cyan", "-.")}
+    if runs:
+        fig, axes = plt.subplots(1, 2, figsize=(12, 5.5))
+        z = np.asarray(runs[0].series["z"]) / H
+        for ax, zoom in zip(axes, (False, True)):
+            ax.plot(np.asarray(runs[0].series["p_exact"][0]) / p0, z, color="k", lw=2.5, alpha=0.4, label="exact")
+            for r in runs:
+                color, ls = styles.get(r.method.split("-", 1)[1], ("0.3", "-"))
+                ax.plot(np.asarray(r.series["p"][0]) / p0, z, color=color, ls=ls, lw=1.3,
+                        label=f"{r.method} (overshoot {r.errors['first_step_overshoot']:+.0%})")
+            ax.set_xlabel("p / p0 [-]")
+            ax.set_ylabel("height y / H [-] (drained top at 1)")
+            ax.grid(alpha=0.3)
+            if zoom:
+                ax.set_ylim(0.7, 1.0)
+                ax.set_title("near the drained top")
+            else:
+                ax.set_title(f"whole column, t = {prm['dt']:g} s (first step)")
+                ax.legend(fontsize=7)
+        fig.suptitle(f"Terzaghi, {prm['nx']} x {prm['ny']} nodes: pressure after the first step "
+                     f"(c_v dt / h^2 = {prm['c_v'] * prm['dt'] / (H / (prm['ny'] - 1)) ** 2:.1e})")
+        fig.tight_layout()
+        files.append(out / "first_step.png")
+        fig.savefig(files[-1], dpi=130)
+        plt.close(fig)
+        if len(runs[0].series["t"]) > 1:
+            fig, ax = plt.subplots(figsize=(6.5, 5.5))
+            ts = runs[0].series["t"]
+            colors = plt.cm.viridis(np.linspace(0, 0.85, len(ts)))
+            best = [r for r in runs if r.method in ("rkpm-scni+fpp", "fem-taylor-hood")] or runs[:1]
+            for i, t in enumerate(ts):
+                ax.plot(np.asarray(runs[0].series["p_exact"][i]) / p0, z, color=colors[i], lw=2.5, alpha=0.4,
+                        label=f"exact, t = {t:.3g} s")
+                for j, r in enumerate(best):
+                    ax.plot(np.asarray(r.series["p"][i])[::25] / p0, z[::25], ls="none", marker="os"[j % 2],
+                            mfc="none", color=colors[i], label=r.method if i == 0 else None)
+            ax.set_xlabel("p / p0 [-]")
+            ax.set_ylabel("y / H [-]")
+            ax.set_title("consolidation: lines exact, markers numerical")
+            ax.legend(fontsize=7)
+            ax.grid(alpha=0.3)
+            fig.tight_layout()
+            files.append(out / "consolidation.png")
+            fig.savefig(files[-1], dpi=130)
+            plt.close(fig)
+    ref = [r for r in results.runs if r.info["study"] == "refinement"]
+    if ref:
+        fig, ax = plt.subplots(figsize=(7, 5.5))
+        z = np.asarray(ref[0].series["z"]) / H
+        ax.plot(np.asarray(ref[0].series["p_exact"][0]) / p0, z, color="k", lw=2.5, alpha=0.4, label="exact")
+        for r in ref:
+            base = r.method.split(" ")[0]
+            shade = {21: 0.45, 41: 0.7, 81: 1.0}.get(r.info["ny"], 0.8)
+            color = plt.cm.Blues(shade) if base.startswith("rkpm") else plt.cm.Greens(shade)
+            ax.plot(np.asarray(r.series["p"][0]) / p0, z, color=color, ls="-" if base.startswith("rkpm") else ":",
+                    label=f"{r.method} (L2 {r.errors['first_step_l2']:.2e})")
+        ax.set_ylim(0.8, 1.0)
+        ax.set_xlabel("p / p0 [-]")
+        ax.set_ylabel("y / H [-] (drained top at 1)")
+        ax.set_title(f"first-step pressure near the drained top, t = {prm['dt']:g} s")
+        ax.legend(fontsize=8)
+        ax.grid(alpha=0.3)
+        fig.tight_layout()
+        files.append(out / "refinement.png")
+        fig.savefig(files[-1], dpi=130)
+        plt.close(fig)
+    return files
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Command-line entry point (see the module docstring)."""
+    return _cli.main(NAME, __doc__, PARAMS, run, plot, argv, QUICK)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,66 @@
+"""Mandel's problem (seed 3.4.2): the acceptance criteria of the Chapter 3 case."""
+import json
+
+import numpy as np
+import pytest
+
+from rkfx.cases import mandel
+
+
+@pytest.fixture(scope="module")
+def seed():
+    """The seed's resolution, SCNI+FPP and NI, Taylor-Hood beside them."""
+    pytest.importorskip("dolfinx_solver")
+    return {r.method: r for r in mandel.run(methods=("rkpm", "fem"), t_D=[0.01, 0.1, 0.5],
+                                             variants=["scni+fpp"], early_variants=["ni", "scni+fpp"],
+                                             fem=["taylor-hood"]).runs}
+
+
+@pytest.mark.parametrize("method", ["rkpm-scni+fpp", "fem-taylor-hood"])
+@pytest.mark.parametrize("t_d", [0.01, 0.1, 0.5])
+def test_pressure_along_the_axis_within_3_percent(seed, method, t_d):
+    assert seed[method].errors[f"l2_p_TD{t_d:g}"] <= 0.03
+
+
+def test_mandel_cryer_effect(seed):
+    r = seed["rkpm-scni+fpp"]
+    early = np.asarray(r.series["history_t_D"]) < 0.05
+    assert np.asarray(r.series["history_p"])[early].max() > 1.05  # p0+ = 1
+    assert r.errors["cryer_peak"] > 1.1
+
+
+def test_early_time_stable_with_scni_fpp_and_oscillating_with_ni(seed):
+    assert seed["rkpm-scni+fpp"].errors["early_dtD0.01_overshoot"] <= 0.05
+    assert seed["rkpm-ni"].errors["early_dtD0.01_overshoot"] > 0.20
+
+
+def test_other_parameters_still_match_the_exact_solution():
+    """nu = 0.2, a different load, permeability and size: no formula may assume the seed's values."""
+    res = mandel.run(methods=("rkpm",), nu=0.2, E=2.0e4, k=3.0e-4, F=25.0, Lx=10.0, Ly=1.0, nx=81, ny=9,
+                     t_D=[0.01, 0.1, 0.5], variants=["scni+fpp"], early_variants=[])
+    errors = res.runs[0].errors
+    assert all(errors[f"l2_p_TD{t:g}"] <= 0.03 for t in (0.01, 0.1, 0.5)), errors
+    assert res.params["c"] != 1.0 and res.params["p0"] != 1.0
+
+
+def test_cli_quick_writes_results_and_figures(tmp_path):
+    pytest.importorskip("dolfinx_solver")
+    assert mandel.main(["--quick", "--out", str(tmp_path)]) == 0
+    data = json.loads((tmp_path / "results.json").read_text())
+    assert data["case"] == "mandel"
+    run = next(r for r in data["runs"] if r["method"] == "rkpm-scni+fpp")
+    assert {"x", "t_D", "p", "p_exact"} <= set(run["series"])
+    assert len(run["series"]["p"]) == len(run["series"]["t_D"]) == 2
+    assert len(run["series"]["p"][0]) == len(run["series"]["x"])
+    assert (tmp_path / "profiles.png").stat().st_size > 10_000
+    assert (tmp_path / "early_time.png").stat().st_size > 10_000
+
+
+@pytest.mark.parametrize("arg, word", [("bogus=1", "bogus"), ("nu=0.5", "Poisson"), ("k=-1", "mobility"),
+                                       ("variants=foo", "variant"), ("nx=2", "nx")])
+def test_bad_parameters_exit_2_with_one_line(arg, word, capsys):
+    with pytest.raises(SystemExit) as e:
+        mandel.main(["--quick", "--method", "rkpm", "--set", arg])
+    assert e.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and word in err
