@@ -2,4 +2,8 @@
 
     kirsch         infinite plane-strain plate with a circular hole under remote uniaxial tension
     manufactured   manufactured plane-strain fields (sine field with its body force; linear patch)
+    terzaghi       1-D consolidation of a column (Fourier and short-time erfc series), general Biot
+    mandel         Mandel's squeezed slab (Abousleiman et al. 1996), general Biot, S = 0 explicit
+    strip_load     strip load on a drained poroelastic half-plane (Schiffman, Chen & Jordan 1969),
+                   incompressible constituents, closed form in Fourier space + quadrature
 """
