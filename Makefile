@@ -3,7 +3,7 @@
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.rkfx-installed
-DEMO   ?= plate_with_hole
+DEMO   ?= mandel
 
 .PHONY: demo test test-slow test-mpi bench env clean
 
