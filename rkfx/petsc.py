@@ -5,18 +5,20 @@ function takes an MPI communicator. Matrices are distributed by contiguous row b
 (PETSc's default ownership); each rank inserts only the rows it owns from the CSR data it
 holds, so the same code runs serially and under ``mpiexec -n P``.
 """
+import warnings
+
 import dolfinx_solver  # noqa: F401  (orders MPI before petsc4py)
 import numpy as np
 import scipy.sparse as sp
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from .errors import InputError
+from .errors import InputError, SolverError
 
 SOLVERS = ("mumps", "gmres-ilu", "cg-gamg")
 
 
-class SolverDiverged(RuntimeError):
+class SolverDiverged(SolverError):
     """A PETSc linear solve did not converge."""
 
 
@@ -102,6 +104,7 @@ class LinearSolver:
         self.rhs = self.mat.createVecLeft()
         self.x = self.mat.createVecRight()
         self.residual = self.mat.createVecLeft()
+        self._warned = False
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         """The whole solution on every rank."""
@@ -112,11 +115,7 @@ class LinearSolver:
         except PETSc.Error as err:
             raise SolverDiverged(f"PETSc solver {self.solver!r} failed ({err}); the system may be singular: "
                                  "check that essential boundary conditions remove all rigid-body modes") from None
-        if self.solver == "mumps":
-            null_pivots = self.ksp.getPC().getFactorMatrix().getMumpsInfog(28)
-            if null_pivots > 0:
-                raise SolverDiverged(f"the system matrix is singular ({null_pivots} null pivots): essential "
-                                     "boundary conditions must remove all rigid-body modes")
+        null_pivots = self.ksp.getPC().getFactorMatrix().getMumpsInfog(28) if self.solver == "mumps" else 0
         reason = self.ksp.getConvergedReason()
         if reason < 0:
             raise SolverDiverged(f"PETSc solver {self.solver!r} diverged (KSPConvergedReason {reason}) after "
@@ -126,9 +125,15 @@ class LinearSolver:
         self.residual.axpy(-1.0, self.rhs)
         scale = max(self.rhs.norm(), 1e-300)
         if self.residual.norm() > 1e-6 * scale:
+            what = f"singular ({null_pivots} null pivots)" if null_pivots else "singular or ill-conditioned"
             raise SolverDiverged(f"PETSc solver {self.solver!r} left a relative residual of "
-                                 f"{self.residual.norm() / scale:.2e}: the system is singular or "
-                                 "ill-conditioned; check the boundary conditions")
+                                 f"{self.residual.norm() / scale:.2e}: the system is {what}; check that the "
+                                 "essential boundary conditions remove all rigid-body modes")
+        if null_pivots and not self._warned:
+            # Consistent but nearly singular, e.g. the spurious modes of direct nodal integration.
+            warnings.warn(f"system matrix has {null_pivots} null pivot(s) (nearly singular); the solution "
+                          "satisfies the equations but is not unique in those modes", RuntimeWarning, stacklevel=2)
+            self._warned = True
         return gather(self.x)
 
     def destroy(self) -> None:

@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, SolverError
 from ..warmup import warm_up
 
 METHODS = {"rkpm": ("rkpm",), "fem": ("fem",), "both": ("rkpm", "fem")}
@@ -184,7 +184,7 @@ def main(name: str, doc: str | None, specs: Mapping[str, Param], run: Callable[.
         params = parse_params(specs, args.overrides, quick if args.quick else None)
         warm_up()  # wall times below measure the methods, not the JIT compiler
         results = run(methods=METHODS[args.method], **params)
-    except InputError as err:
+    except (InputError, SolverError) as err:
         _fail(parser.prog, err)
     if _rank() != 0:
         return 0
