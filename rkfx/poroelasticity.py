@@ -323,8 +323,9 @@ def time_grid(output_times: Sequence[float], first_step: float, growth: float = 
 def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_times: Sequence[float],
                displacements: Sequence[Displacement] = (), pressures: Sequence[Pressure] = (),
                tractions: Sequence[TotalTraction] = (), fluxes: Sequence[Flux] = (),
-               variant: str = "scni+fpp", support_factor: float = 1.5, comm=None,
-               solver: str = "mumps", progress: Callable | None = None) -> BiotSolution:
+               variant: str = "scni+fpp", support_factor: float = 1.5,
+               gravity: Sequence[float] | None = None, density: float = 0.0, fluid_density: float = 0.0,
+               comm=None, solver: str = "mumps", progress: Callable | None = None) -> BiotSolution:
     """Solve the u-p equations by backward Euler on the step times ``times`` (t_0 = 0).
 
     Initial state u = 0, p = 0. Loads and prescribed values are evaluated at t_{n+1} (3.39)-(3.40).
@@ -339,6 +340,9 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
             impermeable.
         variant: ``ni``, ``scni``, ``ni+fpp`` or ``scni+fpp``.
         support_factor: a_I = c h_I.
+        gravity: Gravitational acceleration g, e.g. ``(0, -9.81)`` [m/s^2]; ``None`` for none.
+        density: Mixture density rho = n_f rho_f + (1 - n_f) rho_s [kg/m^3] (body force rho g).
+        fluid_density: rho_f [kg/m^3] (Darcy flux -k (grad p - rho_f g), eq. 3.10).
         comm, solver: Passed to the linear solver (PETSc when installed).
         progress: Optional wrapper of the step iterator (e.g. a progress bar).
     """
@@ -361,6 +365,15 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
     col = _collocation(p, rk, displacements, pressures)
     nb = bq.rows.matrix(0)
     n = p.num_nodes
+    # Gravity (3.36)-(3.37), integrated at the nodes like the other nodal terms.
+    f_gravity, q_gravity = np.zeros(2 * n), np.zeros(n)
+    if gravity is not None:
+        g = np.asarray(gravity, float).reshape(2)
+        nodal = dni(p, rk, d) if not variant.startswith("scni") else scni(p, rk, d)
+        w = nodal.weights
+        f_gravity = (nodal.values.matrix().T @ (w[:, None] * density * g)).ravel()
+        grad = nodal.gradients
+        q_gravity = material.k * fluid_density * (grad.matrix(0).T @ (w * g[0]) + grad.matrix(1).T @ (w * g[1]))
     timings["assemble"] = time.perf_counter() - t0
     t0 = time.perf_counter()
 
@@ -375,7 +388,7 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
             sel = bq.select([p.tag(fl.boundary)])
             q -= nb[np.flatnonzero(sel)].T @ (bq.weights[sel]
                                                * np.asarray(fl.value(bq.points[sel], t, bq.normals[sel]), float))
-        return f.ravel(), q  # F^ext (3.36) and Q^ext (3.37)
+        return f.ravel() + f_gravity, q + q_gravity  # F^ext (3.36) and Q^ext (3.37)
 
     solvers = {}
     state = np.zeros(3 * n)

@@ -1,0 +1,76 @@
+"""RK u-p solver: boundary fluxes, gravity, operators and input checks."""
+import numpy as np
+import pytest
+
+from rkfx.errors import InputError
+from rkfx.nodal_domains import nodal_domains
+from rkfx.particles import structured
+from rkfx.poroelasticity import (Displacement, Flux, PoroMaterial, Pressure, biot_operators, fpp_parameter,
+                                 solve_biot, time_grid, zero)
+from rkfx.shape_functions import rk_approximation
+
+H = 4.0
+MATERIAL = PoroMaterial(E=1.0e6, nu=0.25, k=1.0e-6)
+COLUMN = structured(1.0, H, 5, 17)
+FIXED = [Displacement("bottom", zero), Displacement("left", zero, (0,)), Displacement("right", zero, (0,))]
+DRAINED_TOP = [Pressure("top", lambda x, t: np.zeros(len(x)))]
+AXIS = np.column_stack([np.full(9, 0.5), np.linspace(0.0, H, 9)])
+LONG = time_grid([1.0e8], 10.0, 2.0, hold=2)  # to steady state
+
+
+@pytest.mark.parametrize("variant, rtol", [("scni+fpp", 1e-6), ("ni", 1e-2)])
+def test_inflow_through_the_bottom_gives_a_linear_steady_pressure(variant, rtol):
+    """Outward flux q.n = -v at the bottom, p = 0 on top: Darcy gives p = v (H - z) / k.
+
+    SCNI is integration-consistent, so the linear field is exact; NI is only close.
+    """
+    v = 1.0e-7
+    sol = solve_biot(COLUMN, MATERIAL, LONG, [LONG[-1]], FIXED, DRAINED_TOP,
+                     fluxes=[Flux("bottom", lambda x, t, n: np.full(len(x), -v))], variant=variant)
+    p = sol.pressure(AXIS)[0]
+    assert np.allclose(p, v * (H - AXIS[:, 1]) / MATERIAL.k, rtol=rtol, atol=rtol * v * H / MATERIAL.k)
+
+
+def test_gravity_gives_hydrostatic_pressure_and_settles_under_self_weight():
+    rho_f, rho, g = 1000.0, 2000.0, 9.81
+    sol = solve_biot(COLUMN, MATERIAL, LONG, [LONG[-1]], FIXED, DRAINED_TOP, gravity=(0.0, -g), density=rho,
+                     fluid_density=rho_f)
+    p = sol.pressure(AXIS)[0]
+    assert np.allclose(p, rho_f * g * (H - AXIS[:, 1]), rtol=1e-6, atol=1e-6 * rho_f * g * H)
+    # Drained oedometric settlement of the top under the buoyant weight: (rho - rho_f) g H^2 / (2 K_v);
+    # the displacement is quadratic in depth, so a linear basis is within O(h^2) (0.07% here).
+    kv = MATERIAL.elastic.constrained_modulus
+    u_top = sol.displacement(np.array([[0.5, H]]))[0, 0, 1]
+    assert u_top == pytest.approx(-(rho - rho_f) * g * H**2 / (2 * kv), rel=3e-3)
+
+
+def test_fpp_parameter_vanishes_in_the_drained_limit():
+    h = np.array([0.1])
+    c = MATERIAL.consolidation_coefficient
+    assert fpp_parameter(MATERIAL, 1e-9 * h[0] ** 2 / c, h)[0] == pytest.approx(
+        2.0 / MATERIAL.oedometric_storage_modulus * (1 + np.tanh(2.0)) / 2, rel=1e-6)
+    assert fpp_parameter(MATERIAL, 0.5 * h[0] ** 2 / c, h)[0] == 0.0
+
+
+def test_projection_rows_annihilate_constants():
+    """S of eq. (3.60) has constants in its kernel (Pi reproduces them)."""
+    p = structured(2.0, 1.0, 9, 5)
+    rk = rk_approximation(p.x, p.spacing)
+    for variant in ("scni+fpp", "ni+fpp"):
+        ops = biot_operators(p, rk, nodal_domains(p), MATERIAL, variant)
+        s = ops.stabilization(np.ones(p.num_nodes))
+        assert np.abs(s @ np.ones(p.num_nodes)).max() < 1e-12 * abs(s).max()
+        assert abs(s).max() > 0
+
+
+def test_bad_input():
+    with pytest.raises(InputError, match="mobility"):
+        PoroMaterial(1.0, 0.2, k=0.0)
+    with pytest.raises(InputError, match="Biot coefficient"):
+        PoroMaterial(1.0, 0.2, k=1.0, alpha=1.5)
+    with pytest.raises(InputError, match="unknown variant"):
+        solve_biot(COLUMN, MATERIAL, np.array([0.0, 1.0]), [1.0], FIXED, variant="gauss")
+    with pytest.raises(InputError, match="output time"):
+        solve_biot(COLUMN, MATERIAL, np.array([0.0, 1.0]), [0.5], FIXED)
+    with pytest.raises(InputError, match="no essential boundary conditions"):
+        solve_biot(COLUMN, MATERIAL, np.array([0.0, 1.0]), [1.0])
