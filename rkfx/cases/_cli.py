@@ -269,3 +269,35 @@ def progress(iterable: Iterable, desc: str = "", total: int | None = None) -> It
     except ImportError:
         return iterable
     return tqdm(iterable, desc=desc, total=total, leave=False)
+
+
+# Line style of each method, shared by the figures of all cases: (colour, linestyle).
+METHOD_STYLES = {"ni": ("tab:red", "-"), "scni": ("tab:orange", "-"), "ni+fpp": ("tab:purple", "--"),
+                 "scni+fpp": ("tab:blue", "-"), "taylor-hood": ("tab:green", ":"), "q1q1": ("tab:brown", ":"),
+                 "q1q1-fpp": ("tab:cyan", "-.")}
+
+
+def method_style(method: str) -> tuple[str, str]:
+    """Colour and linestyle of a run label such as ``rkpm-scni+fpp`` or ``fem-taylor-hood ny=41``."""
+    key = method.split(" ")[0].split("-", 1)[-1]
+    return METHOD_STYLES.get(key, ("0.3", "-"))
+
+
+def pyplot():
+    """``matplotlib.pyplot`` on the non-interactive Agg backend (figures are files, no display)."""
+    import matplotlib  # noqa: PLC0415
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    return plt
+
+
+def save(fig, path: Path, dpi: int = 130) -> Path:
+    """Write a figure and close it."""
+    fig.savefig(path, dpi=dpi)
+    fig.clf()
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    plt.close(fig)
+    return path

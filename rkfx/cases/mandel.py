@@ -150,8 +150,8 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, 
     if "rkpm" in methods:
         for v in dict.fromkeys(list(variants) + list(early_variants)):
             solvers.append((f"rkpm-{v}", v in variants, v in early_variants,
-                            lambda tt, out, v=v, desc="": _rkpm(particles, material, exact, tt, out, v,
-                                                                 support_factor, f"rkpm {v}")))
+                            lambda tt, out, v=v: _rkpm(particles, material, exact, tt, out, v, support_factor,
+                                                       f"rkpm {v}")))
     if "fem" in methods:
         for e in fem:
             def fem_solve(tt, out, e=e):
@@ -192,10 +192,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, 
 
 def plot(results: Results, out: Path) -> list[Path]:
     """Profiles with the Mandel-Cryer history, and the early-time comparison (Fig 3.8)."""
-    import matplotlib  # noqa: PLC0415
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt  # noqa: PLC0415
+    plt = _cli.pyplot()
 
     prm = results.params
     Lx, p0 = prm["Lx"], prm["p0"]
@@ -236,23 +233,17 @@ def plot(results: Results, out: Path) -> list[Path]:
         fig.suptitle(f"Mandel's problem, {prm['nx']} x {prm['ny']} nodes, nu = {prm['nu']:g}, "
                      f"c = {prm['c']:.3g}, p0+ = {p0:.3g}")
         fig.tight_layout()
-        files.append(out / "profiles.png")
-        fig.savefig(files[-1], dpi=130)
-        plt.close(fig)
+        files.append(_cli.save(fig, out / "profiles.png"))
     early = [r for r in results.runs if "early_dtD0.01" in r.series]
     if early:
         fig, axes = plt.subplots(1, len(EARLY), figsize=(5 * len(EARLY), 4.6), sharey=True)
         x = np.asarray(early[0].series["x"]) / Lx
-        styles = {"ni": ("tab:red", "-"), "scni": ("tab:orange", "-"), "ni+fpp": ("tab:purple", "--"),
-                  "scni+fpp": ("tab:blue", "-"), "taylor-hood": ("tab:green", ":"), "q1q1": ("tab:brown", ":"),
-                  "q1q1-fpp": ("tab:cyan", "-.")}
         for ax, (dtd, nsteps) in zip(np.atleast_1d(axes), EARLY):
             tag = f"early_dtD{dtd:g}"
             ax.plot(x, np.asarray(early[0].series[tag + "_exact"]) / p0, color="k", lw=2.5, alpha=0.4,
                     label="exact")
             for r in early:
-                key = r.method.split("-", 1)[1]
-                color, ls = styles.get(key, ("0.3", "-"))
+                color, ls = _cli.method_style(r.method)
                 ax.plot(x, np.asarray(r.series[tag]) / p0, color=color, ls=ls, lw=1.2,
                         label=f"{r.method} ({r.errors[tag + '_overshoot']:+.0%})")
             ax.set_xlim(0.8, 1.0)
@@ -263,9 +254,7 @@ def plot(results: Results, out: Path) -> list[Path]:
         np.atleast_1d(axes)[0].set_ylabel("p / p0+ along y = 0 [-]")
         fig.suptitle("Early-time pressure near the drained side: spurious oscillation without stabilization")
         fig.tight_layout()
-        files.append(out / "early_time.png")
-        fig.savefig(files[-1], dpi=130)
-        plt.close(fig)
+        files.append(_cli.save(fig, out / "early_time.png"))
     return files
 
 

@@ -272,12 +272,11 @@ def _add_rates(runs: list[Run]):
 
 def plot(results: Results, out: Path) -> list[Path]:
     """Figures (PNG in ``out``): sigma_xx along x = 0, convergence, nodal error field."""
-    import matplotlib  # noqa: PLC0415
-    matplotlib.use("Agg")
     import matplotlib.ticker  # noqa: PLC0415
-    import matplotlib.pyplot as plt  # noqa: PLC0415
     from matplotlib.colors import LogNorm  # noqa: PLC0415
     from matplotlib.tri import Triangulation  # noqa: PLC0415
+
+    plt = _cli.pyplot()
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -305,9 +304,7 @@ def plot(results: Results, out: Path) -> list[Path]:
     axes[1].set_title(f"near the hole (exact 3T = {3 * T:g} Pa at y = a)")
     axes[1].legend(frameon=False, loc="upper left", bbox_to_anchor=(1.02, 1.0))
     fig.suptitle(rf"$\sigma_{{xx}}$ along x = 0, finest mesh (h = {finest[methods[0]].info['h']:g} m)")
-    files.append(out / "sigma_xx_axis.png")
-    fig.savefig(files[-1], dpi=130)
-    plt.close(fig)
+    files.append(_cli.save(fig, out / "sigma_xx_axis.png"))
 
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.4), sharex=True, layout="constrained")
     hs = np.array(sorted({r.info["h"] for r in results.runs}))
@@ -332,9 +329,7 @@ def plot(results: Results, out: Path) -> list[Path]:
     axes[1].legend(frameon=False, fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0),
                    title="rates L2 / H1 (finest pair)" if len(hs) > 1 else None, title_fontsize=8)
     fig.suptitle("Plate with a hole: convergence against the Kirsch solution")
-    files.append(out / "convergence.png")
-    fig.savefig(files[-1], dpi=130)
-    plt.close(fig)
+    files.append(_cli.save(fig, out / "convergence.png"))
 
     n = len(methods)
     ncol = min(n, 3)
@@ -355,9 +350,7 @@ def plot(results: Results, out: Path) -> list[Path]:
         ax.set_visible(False)
     fig.colorbar(pc, ax=axes.ravel().tolist(), label=r"$|u^h - u| \,/\, \max|u|$ at the nodes [-]")
     fig.suptitle(f"Nodal displacement error, finest mesh ({finest[methods[0]].info['nodes']} nodes)")
-    files.append(out / "error_field.png")
-    fig.savefig(files[-1], dpi=130)
-    plt.close(fig)
+    files.append(_cli.save(fig, out / "error_field.png"))
     return files
 
 

@@ -204,11 +204,9 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.0, k=5.0e-8 /
 
 def plot(results: Results, out: Path) -> list[Path]:
     """Axis profile and history (Figs 3.11-3.12); low-permeability fields (Fig 3.13)."""
-    import matplotlib  # noqa: PLC0415
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt  # noqa: PLC0415
     import matplotlib.ticker  # noqa: PLC0415
+
+    plt = _cli.pyplot()
 
     prm = results.params
     q, b = prm["q"], prm["b"]
@@ -242,9 +240,7 @@ def plot(results: Results, out: Path) -> list[Path]:
         ax2.grid(alpha=0.3, which="both")
         fig.suptitle(f"Strip load on a consolidating half-space, {prm['nx']} x {prm['ny']} graded nodes")
         fig.tight_layout()
-        files.append(out / "drained.png")
-        fig.savefig(files[-1], dpi=130)
-        plt.close(fig)
+        files.append(_cli.save(fig, out / "drained.png"))
     low = [r for r in results.runs if r.info["study"] == "undrained"]
     if low:
         fig, axes = plt.subplots(3, len(low), figsize=(4.6 * len(low) + 1.5, 12), squeeze=False,
@@ -265,9 +261,7 @@ def plot(results: Results, out: Path) -> list[Path]:
                 ax.set_ylabel("y / b")
             fig.colorbar(tc, ax=list(axes[i]), shrink=0.85, label=name)
         fig.suptitle(f"Low permeability, impermeable surface: fields after {prm['steps_low']} steps")
-        files.append(out / "undrained_fields.png")
-        fig.savefig(files[-1], dpi=110)
-        plt.close(fig)
+        files.append(_cli.save(fig, out / "undrained_fields.png", dpi=110))
     return files
 
 

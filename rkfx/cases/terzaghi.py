@@ -176,25 +176,19 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e3, nu=0.0, k=1.0e-9, 
 
 def plot(results: Results, out: Path) -> list[Path]:
     """First-step profiles of every method (Fig 3.5), later profiles, and the refinement (Fig 3.6)."""
-    import matplotlib  # noqa: PLC0415
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt  # noqa: PLC0415
+    plt = _cli.pyplot()
 
     prm = results.params
     H, p0 = prm["H"], prm["p0"]
     files = []
     runs = [r for r in results.runs if r.info["study"] == "variants"]
-    styles = {"ni": ("tab:red", "-"), "scni": ("tab:orange", "-"), "ni+fpp": ("tab:purple", "--"),
-              "scni+fpp": ("tab:blue", "-"), "taylor-hood": ("tab:green", ":"), "q1q1": ("tab:brown", ":"),
-              "q1q1-fpp": ("tab:cyan", "-.")}
     if runs:
         fig, axes = plt.subplots(1, 2, figsize=(12, 5.5))
         z = np.asarray(runs[0].series["z"]) / H
         for ax, zoom in zip(axes, (False, True)):
             ax.plot(np.asarray(runs[0].series["p_exact"][0]) / p0, z, color="k", lw=2.5, alpha=0.4, label="exact")
             for r in runs:
-                color, ls = styles.get(r.method.split("-", 1)[1], ("0.3", "-"))
+                color, ls = _cli.method_style(r.method)
                 ax.plot(np.asarray(r.series["p"][0]) / p0, z, color=color, ls=ls, lw=1.3,
                         label=f"{r.method} (overshoot {r.errors['first_step_overshoot']:+.0%})")
             ax.set_xlabel("p / p0 [-]")
@@ -209,9 +203,7 @@ def plot(results: Results, out: Path) -> list[Path]:
         fig.suptitle(f"Terzaghi, {prm['nx']} x {prm['ny']} nodes: pressure after the first step "
                      f"(c_v dt / h^2 = {prm['c_v'] * prm['dt'] / (H / (prm['ny'] - 1)) ** 2:.1e})")
         fig.tight_layout()
-        files.append(out / "first_step.png")
-        fig.savefig(files[-1], dpi=130)
-        plt.close(fig)
+        files.append(_cli.save(fig, out / "first_step.png"))
         if len(runs[0].series["t"]) > 1:
             fig, ax = plt.subplots(figsize=(6.5, 5.5))
             ts = runs[0].series["t"]
@@ -229,9 +221,7 @@ def plot(results: Results, out: Path) -> list[Path]:
             ax.legend(fontsize=7)
             ax.grid(alpha=0.3)
             fig.tight_layout()
-            files.append(out / "consolidation.png")
-            fig.savefig(files[-1], dpi=130)
-            plt.close(fig)
+            files.append(_cli.save(fig, out / "consolidation.png"))
     ref = [r for r in results.runs if r.info["study"] == "refinement"]
     if ref:
         fig, ax = plt.subplots(figsize=(7, 5.5))
@@ -250,9 +240,7 @@ def plot(results: Results, out: Path) -> list[Path]:
         ax.legend(fontsize=8)
         ax.grid(alpha=0.3)
         fig.tight_layout()
-        files.append(out / "refinement.png")
-        fig.savefig(files[-1], dpi=130)
-        plt.close(fig)
+        files.append(_cli.save(fig, out / "refinement.png"))
     return files
 
 
