@@ -38,7 +38,6 @@ early_variants (list), fem (list), support_factor [-].
     python -m rkfx.cases.mandel [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
 """
 import sys
-import time
 from collections.abc import Sequence
 from pathlib import Path
 
