@@ -110,26 +110,67 @@ def traction_load(p: Particles, bq: BoundaryQuadrature, tractions: Sequence[Trac
     return f.ravel()
 
 
+@dataclass(frozen=True)
+class Collocation:
+    """Rows ``u^h_c(x_I)`` at the nodes of prescribed boundary parts (the transformation method).
+
+    Attributes:
+        G: Constraint rows over all unknowns of the problem, shape ``(k, num_unknowns)``.
+        parts: ``(condition, j, component, nodes, num_components)`` per block of rows, to
+            evaluate the prescribed values in the same order.
+    """
+
+    G: sp.csr_matrix
+    parts: list
+
+    def values(self, x: np.ndarray, *args) -> np.ndarray:
+        """Prescribed values, shape ``(k,)``: ``condition.value(x_I, *args)`` per block.
+
+        A value function may return every component ``(m, num_components)`` (the prescribed
+        component is taken), only the prescribed ones ``(m, len(components))``, or ``(m,)``.
+        """
+        out = []
+        for bc, j, c, nodes, ncomp in self.parts:
+            v = np.asarray(bc.value(x[nodes], *args), float).reshape(len(nodes), -1)
+            col = c if (v.shape[1] == ncomp and ncomp > 1) else (j if v.shape[1] > 1 else 0)
+            out.append(v[:, col])
+        return np.concatenate(out) if out else np.zeros(0)
+
+
+def collocation(p: Particles, rk: RKApproximation, fields: Sequence[tuple[Sequence, int, int]],
+                num_unknowns: int) -> Collocation:
+    """Collocation rows for the conditions of several fields of one problem.
+
+    Args:
+        fields: ``(conditions, offset, num_components)`` per field: each condition has
+            ``boundary``, ``value`` and (for vector fields) ``components``; the field's unknowns
+            start at ``offset`` and are interleaved per node. A (node, component) pair already
+            prescribed by an earlier condition is not prescribed again.
+        num_unknowns: Columns of G.
+    """
+    blocks, parts, seen = [], [], set()
+    for conditions, offset, ncomp in fields:
+        for bc in conditions:
+            nodes = p.boundary_nodes(bc.boundary)
+            for j, c in enumerate(getattr(bc, "components", (0,))):
+                fresh = np.array([(offset, c, i) not in seen for i in nodes], bool)
+                seen.update((offset, c, i) for i in nodes)
+                sel = nodes[fresh]
+                if sel.size == 0:
+                    continue
+                coo = evaluate(rk, p.x[sel]).matrix(0).tocoo()
+                blocks.append(sp.csr_matrix((coo.data, (coo.row, offset + ncomp * coo.col + c)),
+                                            shape=(len(sel), num_unknowns)))
+                parts.append((bc, j, c, sel, ncomp))
+    g = sp.vstack(blocks).tocsr() if blocks else sp.csr_matrix((0, num_unknowns))
+    return Collocation(g, parts)
+
+
 def transformation_constraints(p: Particles, rk: RKApproximation,
                                dirichlet: Sequence[Dirichlet]) -> tuple[sp.csr_matrix, np.ndarray]:
     """Rows G (k, 2n) and values g (k,) of u^h_c(x_I) = u_bar_c(x_I) at the nodes of Gamma_u."""
-    rows, values = [], []
-    seen = set()
-    for bc in dirichlet:
-        nodes = p.boundary_nodes(bc.boundary)
-        vals = bc.values_at(p.x[nodes])
-        for j, c in enumerate(bc.components):
-            keep = np.array([(i, c) not in seen for i in nodes], bool)
-            seen.update((i, c) for i in nodes)
-            if not keep.any():
-                continue
-            n_at = evaluate(rk, p.x[nodes[keep]]).matrix(0).tocoo()
-            rows.append(sp.csr_matrix((n_at.data, (n_at.row, 2 * n_at.col + c)),
-                                      shape=(int(keep.sum()), 2 * p.num_nodes)))
-            values.append(vals[keep, j])
-    if not rows:
-        return sp.csr_matrix((0, 2 * p.num_nodes)), np.zeros(0)
-    return sp.vstack(rows).tocsr(), np.concatenate(values)
+    col = collocation(p, rk, [(dirichlet, 0, 2)], 2 * p.num_nodes)
+    return col.G, col.values(p.x)
 
 
 def nitsche_terms(p: Particles, bq: BoundaryQuadrature, d: np.ndarray, dirichlet: Sequence[Dirichlet],

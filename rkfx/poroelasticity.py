@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from .boundary import boundary_quadrature
+from .boundary import boundary_quadrature, collocation
 from .elasticity import ElasticMaterial
 from .errors import InputError
 from .linear_solver import linear_solver
@@ -222,41 +222,6 @@ def zero(x: np.ndarray, t: float, *_) -> np.ndarray:
     return np.zeros((len(x), 2))
 
 
-@dataclass(frozen=True)
-class _Collocation:
-    """Rows G of u^h_c(x_I) (or p^h(x_I)) at the nodes of prescribed boundaries, in X's numbering."""
-
-    G: sp.csr_matrix
-    parts: list  # (bc, column j, nodes)
-
-    def values(self, x: np.ndarray, t: float) -> np.ndarray:
-        out = []
-        for bc, j, nodes in self.parts:
-            v = np.asarray(bc.value(x[nodes], t), float).reshape(len(nodes), -1)
-            out.append(v[:, j] if v.shape[1] > 1 else v[:, 0])
-        return np.concatenate(out) if out else np.zeros(0)
-
-
-def _collocation(p: Particles, rk: RKApproximation, displacements, pressures) -> _Collocation:
-    n = p.num_nodes
-    blocks, parts, seen = [], [], set()
-    for bc, field_offset, comps, ncomp in ([(b, 0, b.components, 2) for b in displacements]
-                                           + [(b, 2 * n, (0,), 1) for b in pressures]):
-        nodes = p.boundary_nodes(bc.boundary)
-        for j, c in enumerate(comps):
-            key_nodes = np.array([(field_offset, c, i) not in seen for i in nodes], bool)
-            seen.update((field_offset, c, i) for i in nodes)
-            sel = nodes[key_nodes]
-            if sel.size == 0:
-                continue
-            coo = evaluate(rk, p.x[sel]).matrix().tocoo()
-            blocks.append(sp.csr_matrix((coo.data, (coo.row, field_offset + ncomp * coo.col + c)),
-                                        shape=(len(sel), 3 * n)))
-            parts.append((bc, j, sel))
-    g = sp.vstack(blocks).tocsr() if blocks else sp.csr_matrix((0, 3 * n))
-    return _Collocation(g, parts)
-
-
 @dataclass
 class BiotSolution:
     """Nodal coefficients at the output times and the approximation to evaluate them.
@@ -362,7 +327,7 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
     d = nodal_domains(p)
     ops = biot_operators(p, rk, d, material, variant)
     bq = boundary_quadrature(p, d, rk)
-    col = _collocation(p, rk, displacements, pressures)
+    col = collocation(p, rk, [(displacements, 0, 2), (pressures, 2 * p.num_nodes, 1)], 3 * p.num_nodes)
     nb = bq.rows.matrix(0)
     n = p.num_nodes
     # Gravity (3.36)-(3.37), integrated at the nodes like the other nodal terms.

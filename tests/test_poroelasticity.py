@@ -74,3 +74,15 @@ def test_bad_input():
         solve_biot(COLUMN, MATERIAL, np.array([0.0, 1.0]), [0.5], FIXED)
     with pytest.raises(InputError, match="no essential boundary conditions"):
         solve_biot(COLUMN, MATERIAL, np.array([0.0, 1.0]), [1.0])
+
+
+def test_a_condition_on_u_y_takes_u_y_from_a_full_vector_value():
+    """Value functions may return both components; a u_y condition must use the second."""
+    from rkfx.boundary import collocation
+
+    p = structured(1.0, 1.0, 4, 4)
+    rk = rk_approximation(p.x, p.spacing)
+    bc = Displacement("top", lambda x, t: np.column_stack([np.full(len(x), 7.0), np.full(len(x), -3.0)]), (1,))
+    col = collocation(p, rk, [([bc], 0, 2)], 3 * p.num_nodes)
+    assert np.all(col.values(p.x, 0.0) == -3.0)
+    assert np.all(col.G.indices % 2 == 1)  # only u_y coefficients
