@@ -11,6 +11,10 @@ The numerical core (this package's top-level modules) needs only numpy, scipy an
     boundary         boundary integration and essential conditions
     elasticity       material laws
     elastostatics    plane-strain solver
+    poroelasticity   equal-order u-p Biot solver: NI/SCNI with pressure projection (chapter 3)
+    crack_tracking   candidate damage particles along crack segments (eq. 4.22)
+    linear_solver    factorized systems through PETSc when installed, else SciPy
+    warmup           compile the kernels before timing
 
 ``rkfx.petsc`` (imported on purpose) hands the sparse operators to PETSc; ``rkfx.cases``
 holds the runnable benchmarks (``python -m rkfx.cases.<name>``).
