@@ -12,6 +12,7 @@ The numerical core (this package's top-level modules) needs only numpy, scipy an
     elasticity       material laws
     elastostatics    plane-strain solver
     poroelasticity   equal-order u-p Biot solver: NI/SCNI with pressure projection (chapter 3)
+    damage           damage particle method: Mazars strain, damage law, energy regularization (ch. 4)
     crack_tracking   candidate damage particles along crack segments (eq. 4.22)
     linear_solver    factorized systems through PETSc when installed, else SciPy
     warmup           compile the kernels before timing

@@ -1,0 +1,613 @@
+"""The damage particle method's material layer (seed chapter 4): isotropic damage at the particles.
+
+Each damage point (an SCNI particle, or any integration point) carries the scalar damage of
+the continuum damage model (4.1) driven by its *smeared* strain: for SCNI particles that is
+the cell-smoothed strain of eq. (4.21), ``strain_matrix(smoothed_gradients(...).cell) @ d``.
+Everything here is vectorised over the points (numpy; the per-point work is a few flops, so
+a compiled loop would not pay).
+
+* Mazars' equivalent strain (4.6) from the principal strains of Voigt strains
+  (eps_xx, eps_yy, gamma_xy).
+* The linear-softening damage law (4.2) with the irreversible history variable
+  kappa = max(kappa_old, eps_eq) (Kuhn-Tucker conditions 4.3-4.5).
+* The dissipation-energy regularization (4.26)-(4.28): kappa_c = (G_F / f_t) A_L / V_L, with
+  A_L the chord of the particle's nodal domain through x_L along the crack (perpendicular to
+  the crack normal n_L, which is fixed at damage initiation along the major principal
+  direction of the effective stress). ``chord_lengths`` computes it exactly for the
+  median-dual cells of ``rkfx.nodal_domains``.
+* The smeared stress (4.20)/(4.30), sigma = (1 - D) C eps, its consistent tangent, and the
+  dissipated energy.
+* What the damage solvers share (``rkfx.cases.cracked_bar``, ``fem_baselines.crack_band``):
+  ``march``, displacement-controlled stepping with step cutting and a dissipation-controlled
+  fallback through snap-backs, and ``failure_displacement``, u_T^max read off a load path.
+
+Dissipation bookkeeping. Damage dissipates Y dD per unit volume with the energy release rate
+Y = eps : C : eps / 2. In uniaxial tension, the state the energy scaling (4.27) is built on,
+eps = kappa while damage grows, so the dissipation density is a function of kappa alone,
+
+    phi(kappa) = int_{kappa0}^{kappa} E s^2 / 2 D'(s) ds = W(kappa) - E (1 - D) kappa^2 / 2
+               = kappa0 (E min(kappa, kappa_c) - sigma(kappa)) / 2,
+
+the work of the monotonic stress-strain curve minus the elastic energy still stored, with
+sigma(kappa) = E (1 - D(kappa)) kappa on that curve. It is exact for any step size (no
+quadrature in time) and reaches g_L = f_t kappa_c / 2 (4.27) at complete failure. ``update``
+returns V_L (phi(kappa_new) - phi(kappa_old)) summed over the points. For multiaxial states
+the same phi is used (Y evaluated at the equivalent strain); cases check it against the work
+balance W_ext - W_elastic.
+
+Out-of-plane strain in Mazars' norm: plane strain has eps_zz = 0, which adds nothing to (4.6);
+plane stress has eps_zz = -nu / (1 - nu) (eps_xx + eps_yy), which counts when positive.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import InputError
+from .particles import Particles
+
+PLANES = ("strain", "stress")
+
+
+@dataclass(frozen=True)
+class DamageMaterial:
+    """Isotropic elastic-damage solid with linear softening (4.2).
+
+    Attributes:
+        E: Young's modulus [Pa].
+        nu: Poisson's ratio [-].
+        ft: Tensile strength f_t [Pa]; the damage threshold is kappa0 = f_t / E.
+        GF: Fracture energy G_F [J/m^2 = N/m].
+        plane: ``"strain"`` or ``"stress"``: the 2-D idealization of C and of eps_zz in (4.6).
+    """
+
+    E: float
+    nu: float
+    ft: float
+    GF: float
+    plane: str = "strain"
+
+    def __post_init__(self):
+        for name, fix in (("E", "Young's modulus, e.g. E=2e6"), ("ft", "the tensile strength, e.g. ft=200"),
+                          ("GF", "the fracture energy per crack area, e.g. GF=1.885")):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise InputError(f"{name} = {v!r} must be positive and finite ({fix})")
+        if not (-1.0 < self.nu < 0.5):
+            raise InputError(f"Poisson's ratio nu = {self.nu!r} must lie in (-1, 0.5)")
+        if self.plane not in PLANES:
+            raise InputError(f"plane = {self.plane!r}: choose 'strain' or 'stress'")
+        if not self.ft / self.E < 1.0:
+            raise InputError(f"ft / E = {self.ft / self.E:g} is not a small strain; check the units of ft and E")
+
+    @property
+    def kappa0(self) -> float:
+        """Damage threshold kappa0 = f_t / E [-] (4.2)."""
+        return self.ft / self.E
+
+    @property
+    def critical_opening(self) -> float:
+        """Critical crack opening w_c = 2 G_F / f_t of the linear cohesive law (4.7) [m]."""
+        return 2.0 * self.GF / self.ft
+
+    def elasticity(self) -> np.ndarray:
+        """Elastic matrix C in Voigt form (eps_xx, eps_yy, gamma_xy), shape ``(3, 3)`` [Pa]."""
+        E, nu = self.E, self.nu
+        if self.plane == "stress":
+            c = E / (1.0 - nu * nu)
+            return c * np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, 0.5 * (1.0 - nu)]])
+        lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+        mu = E / (2.0 * (1.0 + nu))
+        return np.array([[lam + 2 * mu, lam, 0.0], [lam, lam + 2 * mu, 0.0], [0.0, 0.0, mu]])
+
+
+# --------------------------------------------------------------------------- strain measures
+
+
+def principal_strains(strain: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """In-plane principal strains and the major principal direction.
+
+    Args:
+        strain: Voigt strains (eps_xx, eps_yy, gamma_xy), shape ``(m, 3)``.
+
+    Returns:
+        ``(values, direction)``: principal strains (major first), shape ``(m, 2)``, and the
+        unit major principal direction, shape ``(m, 2)``.
+    """
+    e = np.asarray(strain, float).reshape(-1, 3)
+    mean = 0.5 * (e[:, 0] + e[:, 1])
+    radius = np.hypot(0.5 * (e[:, 0] - e[:, 1]), 0.5 * e[:, 2])
+    theta = 0.5 * np.arctan2(e[:, 2], e[:, 0] - e[:, 1])
+    return np.column_stack([mean + radius, mean - radius]), np.column_stack([np.cos(theta), np.sin(theta)])
+
+
+def _out_of_plane(e: np.ndarray, nu: float, plane: str) -> np.ndarray:
+    if plane == "stress":
+        return -nu / (1.0 - nu) * (e[:, 0] + e[:, 1])
+    return np.zeros(len(e))
+
+
+def equivalent_strain(strain: np.ndarray, nu: float = 0.0, plane: str = "strain") -> np.ndarray:
+    """Mazars' equivalent strain sqrt(sum <eps_I>^2) over the three principal strains (4.6).
+
+    Args:
+        strain: Voigt strains (eps_xx, eps_yy, gamma_xy), shape ``(m, 3)``.
+        nu: Poisson's ratio (enters eps_zz in plane stress only).
+        plane: ``"strain"`` (eps_zz = 0) or ``"stress"``.
+
+    Returns:
+        Shape ``(m,)`` [-].
+    """
+    e = np.asarray(strain, float).reshape(-1, 3)
+    values, _ = principal_strains(e)
+    pos = np.maximum(values, 0.0)
+    ezz = np.maximum(_out_of_plane(e, nu, plane), 0.0)
+    return np.sqrt(pos[:, 0] ** 2 + pos[:, 1] ** 2 + ezz**2)
+
+
+def equivalent_strain_gradient(strain: np.ndarray, nu: float = 0.0, plane: str = "strain") -> np.ndarray:
+    """d eps_eq / d (eps_xx, eps_yy, gamma_xy), shape ``(m, 3)``; zero where eps_eq = 0.
+
+    d eps_I / d eps = n_I (x) n_I, i.e. (n_x^2, n_y^2, n_x n_y) against engineering shear; where
+    the principal strains coincide the sum sum <eps_I> n_I (x) n_I is still unique.
+    """
+    e = np.asarray(strain, float).reshape(-1, 3)
+    values, n1 = principal_strains(e)
+    n2 = np.column_stack([-n1[:, 1], n1[:, 0]])
+    pos = np.maximum(values, 0.0)
+    grad = np.zeros_like(e)
+    for k, n in enumerate((n1, n2)):
+        grad += pos[:, k:k + 1] * np.column_stack([n[:, 0] ** 2, n[:, 1] ** 2, n[:, 0] * n[:, 1]])
+    if plane == "stress":
+        ezz = np.maximum(_out_of_plane(e, nu, plane), 0.0)
+        grad[:, :2] -= (nu / (1.0 - nu) * ezz)[:, None]
+    eq = equivalent_strain(e, nu, plane)
+    out = np.zeros_like(e)
+    np.divide(grad, eq[:, None], out=out, where=eq[:, None] > 0)
+    return out
+
+
+# --------------------------------------------------------------------------- damage law
+
+
+def damage(kappa: np.ndarray, kappa0: np.ndarray | float, kappa_c: np.ndarray | float) -> np.ndarray:
+    """Linear-softening damage D(kappa) of (4.2): 0 below kappa0, 1 beyond kappa_c (broadcasts).
+
+    Where kappa_c <= kappa0 the law has no softening branch and D jumps to 1 at kappa0.
+    """
+    kappa, kappa0, kappa_c = np.broadcast_arrays(*(np.asarray(a, float) for a in (kappa, kappa0, kappa_c)))
+    out = np.zeros(kappa.shape)
+    soft = (kappa >= kappa0) & (kappa_c > kappa0)
+    k = kappa[soft]
+    out[soft] = 1.0 - kappa0[soft] / k * (kappa_c[soft] - k) / (kappa_c[soft] - kappa0[soft])
+    out[(kappa >= kappa0) & ~(kappa_c > kappa0)] = 1.0  # no softening branch: perfectly brittle
+    return np.clip(out, 0.0, 1.0)
+
+
+def damage_slope(kappa: np.ndarray, kappa0: np.ndarray | float, kappa_c: np.ndarray | float) -> np.ndarray:
+    """dD/dkappa of (4.2): kappa0 kappa_c / (kappa^2 (kappa_c - kappa0)) on [kappa0, kappa_c), else 0."""
+    kappa, kappa0, kappa_c = np.broadcast_arrays(*(np.asarray(a, float) for a in (kappa, kappa0, kappa_c)))
+    out = np.zeros(kappa.shape)
+    soft = (kappa >= kappa0) & (kappa < kappa_c)
+    out[soft] = kappa0[soft] * kappa_c[soft] / (kappa[soft] ** 2 * (kappa_c[soft] - kappa0[soft]))
+    return out
+
+
+def dissipation_density(kappa: np.ndarray, kappa0: np.ndarray | float, kappa_c: np.ndarray | float,
+                        E: float) -> np.ndarray:
+    """Energy dissipated per unit volume up to the history kappa [J/m^3] (module docstring).
+
+    phi = kappa0 (E min(kappa, kappa_c) - E (1 - D) kappa) / 2; phi = f_t kappa_c / 2 (4.27) once
+    kappa >= kappa_c, and 0 below kappa0.
+    """
+    kappa, kappa0, kappa_c = np.broadcast_arrays(*(np.asarray(a, float) for a in (kappa, kappa0, kappa_c)))
+    sigma = E * (1.0 - damage(kappa, kappa0, kappa_c)) * kappa
+    return np.where(kappa > kappa0, 0.5 * kappa0 * (E * np.minimum(kappa, kappa_c) - sigma), 0.0)
+
+
+def critical_strain(material: DamageMaterial, chord: np.ndarray, volume: np.ndarray) -> np.ndarray:
+    """Regularized kappa_c = (G_F / f_t) A_L / V_L (4.28), shape like ``chord``.
+
+    In 2-D ``chord`` is the length A_L [m] and ``volume`` the area V_L [m^2] of the nodal domain
+    (both per unit thickness), so the bulk dissipation g_L V_L = f_t kappa_c V_L / 2 equals the
+    fracture energy G_F A_L / 2 of half a crack segment (4.24), (4.26).
+    """
+    return material.GF / material.ft * np.asarray(chord, float) / np.asarray(volume, float)
+
+
+# --------------------------------------------------------------------------- cell chords (A_L)
+
+
+@dataclass(frozen=True)
+class CellGeometry:
+    """The nodal domains as unions of convex subcell quadrilaterals.
+
+    Attributes:
+        node: Node L of each subcell, shape ``(num_subcells,)``.
+        vertices: Counter-clockwise vertices (x_L, m_k, g, m_k-1) of each subcell, shape
+            ``(num_subcells, 4, 2)`` [m]: the node, the midpoint of triangle side k, the
+            triangle's centroid and the midpoint of side k-1 (as in ``rkfx.nodal_domains``).
+        num_nodes: Number of nodes.
+    """
+
+    node: np.ndarray
+    vertices: np.ndarray
+    num_nodes: int
+
+
+def cell_geometry(p: Particles) -> CellGeometry:
+    """Subcell quadrilaterals of the median-dual nodal domains of ``p`` (subcell 3t + k)."""
+    tri = p.triangles
+    v = p.x[tri]                                # (t, 3, 2)
+    nxt = p.x[np.roll(tri, -1, axis=1)]         # vertex k + 1
+    prv = p.x[np.roll(tri, 1, axis=1)]          # vertex k - 1
+    g = np.broadcast_to(v.mean(axis=1, keepdims=True), v.shape)
+    quads = np.stack([v, 0.5 * (v + nxt), g, 0.5 * (prv + v)], axis=2)  # (t, 3, 4, 2)
+    return CellGeometry(tri.reshape(-1), quads.reshape(-1, 4, 2), p.num_nodes)
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _reach(quads: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """Distance from vertex 0 of each convex quad along ``direction`` to the quad's far sides
+    (1 -> 2 and 2 -> 3); 0 where the ray leaves the quad at its vertex (points outside)."""
+    rel = quads - quads[:, :1]
+    scale = np.abs(rel).max(axis=(1, 2))
+    reach = np.zeros(len(quads))
+    for a, b in ((1, 2), (2, 3)):
+        p, e = rel[:, a], rel[:, b] - rel[:, a]
+        det = _cross(e, direction)
+        ok = np.abs(det) > 1e-12 * scale
+        safe = np.where(ok, det, 1.0)
+        s = _cross(e, p) / safe
+        lam = _cross(direction, p) / safe
+        hit = ok & (lam >= -1e-9) & (lam <= 1.0 + 1e-9) & (s > 1e-12 * scale)
+        reach = np.where(hit, np.maximum(reach, s), reach)
+    return reach
+
+
+def chord_lengths(geometry: CellGeometry, nodes: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """Length A_L of the chord of each node's domain through x_L perpendicular to ``normals``.
+
+    The domain is star-shaped with respect to its node, which is a vertex of every subcell, so
+    the chord is the distance from x_L to the domain boundary along +t plus that along -t,
+    t = (-n_y, n_x); each is the exit distance of the ray from the one subcell it runs through
+    (the larger of the two where it runs along a subcell side). Rays leaving the geometry at a
+    boundary node contribute 0.
+
+    Args:
+        geometry: From ``cell_geometry``.
+        nodes: Node indices, shape ``(k,)`` (distinct).
+        normals: Crack normals n_L (unit), shape ``(k, 2)``.
+
+    Returns:
+        A_L, shape ``(k,)`` [m] (per unit thickness in 2-D).
+    """
+    nodes = np.asarray(nodes, np.int64).reshape(-1)
+    n = np.asarray(normals, float).reshape(-1, 2)
+    slot = np.full(geometry.num_nodes, -1, np.int64)
+    slot[nodes] = np.arange(len(nodes))
+    sub = np.flatnonzero(slot[geometry.node] >= 0)
+    where = slot[geometry.node[sub]]
+    t = np.column_stack([-n[:, 1], n[:, 0]])[where]
+    total = np.zeros(len(nodes))
+    for sign in (1.0, -1.0):
+        far = np.zeros(len(nodes))
+        np.maximum.at(far, where, _reach(geometry.vertices[sub], sign * t))
+        total += far
+    return total
+
+
+# --------------------------------------------------------------------------- model and state
+
+
+@dataclass(frozen=True)
+class DamageModel:
+    """The fixed data of the damage points.
+
+    Attributes:
+        material: Material constants.
+        volume: V_L of each point, shape ``(m,)`` [m^2 per unit thickness in 2-D].
+        kappa0: Damage threshold per point (weakened where requested), shape ``(m,)``.
+        geometry: Cell geometry for the regularization (4.28) (points are the nodes of
+            ``geometry``), or ``None`` for the unregularized model.
+        kappa_c: Critical strain per point of the unregularized model, shape ``(m,)``, or
+            ``None`` when regularized.
+    """
+
+    material: DamageMaterial
+    volume: np.ndarray
+    kappa0: np.ndarray
+    geometry: CellGeometry | None
+    kappa_c: np.ndarray | None
+
+    @property
+    def num_points(self) -> int:
+        return len(self.volume)
+
+    @property
+    def regularized(self) -> bool:
+        return self.geometry is not None
+
+
+def damage_model(material: DamageMaterial, volume: np.ndarray, kappa0_factor: np.ndarray | float = 1.0,
+                 geometry: CellGeometry | None = None, kappa_c: np.ndarray | float | None = None,
+                 regularized: bool = True) -> DamageModel:
+    """Validated ``DamageModel``.
+
+    Args:
+        material: Material constants.
+        volume: V_L per point, shape ``(m,)``.
+        kappa0_factor: Multiplier of kappa0 per point (e.g. 0.999 in a weak section), scalar or
+            shape ``(m,)``, in (0, 1].
+        geometry: ``cell_geometry(p)``; needed when ``regularized`` (points = nodes of p).
+        kappa_c: Constant critical strain (scalar or per point) when not ``regularized``.
+        regularized: kappa_c from (4.28) at damage initiation, or the constant ``kappa_c``.
+    """
+    volume = np.ascontiguousarray(volume, float).reshape(-1)
+    m = len(volume)
+    if not np.all(volume > 0):
+        raise InputError("every damage point needs a positive volume V_L; check the nodal domains")
+    factor = np.broadcast_to(np.asarray(kappa0_factor, float), (m,)).copy()
+    if not np.all((factor > 0) & (factor <= 1)):
+        raise InputError(f"kappa0_factor must lie in (0, 1] (e.g. 0.999 for a weak section), got "
+                         f"{factor[~((factor > 0) & (factor <= 1))][0]!r}")
+    kappa0 = material.kappa0 * factor
+    if regularized:
+        if geometry is None:
+            raise InputError("the regularized model (4.28) needs the cell geometry: pass geometry=cell_geometry(p)")
+        if geometry.num_nodes != m:
+            raise InputError(f"geometry has {geometry.num_nodes} nodes but {m} damage points were given")
+        return DamageModel(material, volume, kappa0, geometry, None)
+    if kappa_c is None:
+        raise InputError("the unregularized model needs a constant kappa_c (> kappa0 = ft / E)")
+    kc = np.broadcast_to(np.asarray(kappa_c, float), (m,)).copy()
+    if not np.all(kc > kappa0):
+        raise InputError(f"kappa_c = {kc.min():g} must exceed kappa0 = ft / E = {material.kappa0:g}")
+    return DamageModel(material, volume, kappa0, None, kc)
+
+
+@dataclass(frozen=True)
+class DamageState:
+    """History of the damage points.
+
+    Attributes:
+        kappa: History variable kappa (max equivalent strain reached), shape ``(m,)``.
+        damage: D(kappa), shape ``(m,)``.
+        normal: Crack normal n_L fixed at initiation, shape ``(m, 2)`` (zero before).
+        kappa_c: Critical strain in force, shape ``(m,)`` (NaN before initiation when regularized).
+        damaged: Whether the point has initiated damage (kappa >= kappa0), shape ``(m,)``.
+        chord: A_L at initiation (regularized model), shape ``(m,)`` [m] (NaN otherwise).
+        dissipated: Energy dissipated so far per point, V_L phi(kappa), shape ``(m,)`` [J per
+            unit thickness in 2-D].
+    """
+
+    kappa: np.ndarray
+    damage: np.ndarray
+    normal: np.ndarray
+    kappa_c: np.ndarray
+    damaged: np.ndarray
+    chord: np.ndarray
+    dissipated: np.ndarray
+
+
+def initial_state(model: DamageModel) -> DamageState:
+    """Undamaged state."""
+    m = model.num_points
+    kc = np.full(m, np.nan) if model.regularized else model.kappa_c.copy()
+    return DamageState(np.zeros(m), np.zeros(m), np.zeros((m, 2)), kc, np.zeros(m, bool), np.full(m, np.nan),
+                       np.zeros(m))
+
+
+@dataclass(frozen=True)
+class DamageUpdate:
+    """The response of the damage points to a strain.
+
+    Attributes:
+        state: The trial state (commit it once the step has converged).
+        stress: Smeared stress (1 - D) C eps (4.30), shape ``(m, 3)`` [Pa].
+        tangent: d stress / d strain, shape ``(m, 3, 3)`` [Pa], or ``None``.
+        dissipation: Energy dissipated since ``state`` [J per unit thickness in 2-D].
+    """
+
+    state: DamageState
+    stress: np.ndarray
+    tangent: np.ndarray | None
+    dissipation: float
+
+
+def update(model: DamageModel, state: DamageState, strain: np.ndarray, tangent: bool = True,
+           tangent_floor: float = 0.0, loading_tolerance: float = 0.0) -> DamageUpdate:
+    """Damage, stress and tangent for the strains ``strain`` from the converged ``state``.
+
+    kappa = max(kappa_old, eps_eq(strain)) (4.3)-(4.5). A point crossing its threshold for the
+    first time fixes its crack normal along the major principal direction of the effective
+    stress C eps and, in the regularized model, its kappa_c = (G_F / f_t) A_L / V_L (4.28) with
+    the material's f_t (the weakening factor only triggers localization).
+
+    Args:
+        model: Fixed point data.
+        state: Last converged state.
+        strain: Smeared Voigt strains, shape ``(m, 3)``.
+        tangent: Also form the consistent tangent (1 - D) C - D'(kappa) (C eps) (x) d eps_eq / d eps
+            (the second term on loading points only).
+        tangent_floor: Lower bound of (1 - D) in the tangent only (e.g. 1e-6), which keeps the
+            Newton matrix regular once points have failed; the stress is not affected.
+        loading_tolerance: Points with eps_eq > (1 - loading_tolerance) max(kappa_old, kappa0)
+            count as loading in the tangent (with the slope at kappa0 if still below it). A
+            small positive value makes a point sitting on its threshold (the first iterate of
+            a step, or the peak) soften in the tangent, so that Newton's first prediction
+            follows the softening branch rather than the secant one.
+
+    A regularized kappa_c <= kappa0 (a cell too coarse for G_F) makes the point perfectly
+    brittle; ``check_regularization`` rejects such converged states.
+    """
+    mat = model.material
+    c = mat.elasticity()
+    e = np.asarray(strain, float).reshape(-1, 3)
+    eq = equivalent_strain(e, mat.nu, mat.plane)
+    kappa = np.maximum(state.kappa, eq)
+    effective = e @ c.T
+    # Points crossing their threshold now fix n_L and kappa_c; points within the loading
+    # tolerance below it get prospective values for the tangent only.
+    near = ~state.damaged & (kappa >= (1.0 - loading_tolerance) * model.kappa0)
+    new = near & (kappa >= model.kappa0)
+    normal, kappa_c, chord = state.normal, state.kappa_c, state.chord
+    if near.any():
+        idx = np.flatnonzero(near)
+        s = effective[idx]
+        theta = 0.5 * np.arctan2(2.0 * s[:, 2], s[:, 0] - s[:, 1])
+        normal, kappa_c, chord = normal.copy(), kappa_c.copy(), chord.copy()
+        normal[idx] = np.column_stack([np.cos(theta), np.sin(theta)])
+        if model.regularized:
+            chord[idx] = chord_lengths(model.geometry, idx, normal[idx])
+            kappa_c[idx] = critical_strain(mat, chord[idx], model.volume[idx])
+        prospective = np.flatnonzero(near & ~new)
+        kc_tangent = kappa_c.copy()
+        normal[prospective], chord[prospective] = state.normal[prospective], state.chord[prospective]
+        kappa_c[prospective] = state.kappa_c[prospective]
+    active = state.damaged | new
+    kc = np.where(active, kappa_c, np.inf)
+    d = damage(kappa, model.kappa0, kc)
+    stress = (1.0 - d)[:, None] * effective
+    phi_new = dissipation_density(kappa, model.kappa0, kc, mat.E)
+    phi_old = dissipation_density(state.kappa, model.kappa0, kc, mat.E)
+    diss = model.volume * (phi_new - phi_old)
+    new_state = DamageState(kappa, d, normal, kappa_c, active, chord, state.dissipated + diss)
+    tan = None
+    if tangent:
+        tan = np.maximum(1.0 - d, tangent_floor)[:, None, None] * c
+        kc_t = np.where(near, kc_tangent, kc) if near.any() else kc
+        loading = (eq > (1.0 - loading_tolerance) * np.maximum(state.kappa, model.kappa0)) & (eq < kc_t)
+        if loading.any():
+            i = np.flatnonzero(loading)
+            slope = damage_slope(np.maximum(eq[i], model.kappa0[i]), model.kappa0[i], kc_t[i])
+            grad = equivalent_strain_gradient(e[i], mat.nu, mat.plane)
+            tan[i] -= slope[:, None, None] * effective[i][:, :, None] * grad[:, None, :]
+    return DamageUpdate(new_state, stress, tan, float(diss.sum()))
+
+
+def check_regularization(model: DamageModel, state: DamageState) -> None:
+    """Raise if a damaged point of a converged state has kappa_c <= kappa0 (4.28).
+
+    Raises:
+        InputError: Naming the point, its A_L and V_L, and the admissible cell size: kappa_c > kappa0
+            needs V_L / A_L < E G_F / f_t^2.
+    """
+    bad = np.flatnonzero(state.damaged & ~(state.kappa_c > model.kappa0))
+    if bad.size:
+        i, mat = bad[0], model.material
+        raise InputError(
+            f"damage point {i}: kappa_c = {state.kappa_c[i]:.3g} <= kappa0 = {model.kappa0[i]:.3g} "
+            f"(A_L = {state.chord[i]:.3g}, V_L = {model.volume[i]:.3g}); the cell is too coarse for G_F: refine "
+            f"until V_L / A_L < E G_F / f_t^2 = {mat.E * mat.GF / mat.ft**2:.3g} or raise GF")
+
+
+# --------------------------------------------------------------------------- load stepping
+# Shared by the damage solvers (rkfx.cases.cracked_bar, fem_baselines.crack_band): both drive
+# a tip displacement through softening and read the same quantities off the curve.
+
+
+def march(targets: np.ndarray, attempt, accept, arc=None, energy_step: float = 0.0,
+          max_damage_increment: float = 0.1, min_fraction: float = 1e-3, max_arc_steps: int = 10000) -> dict:
+    """Displacement-controlled stepping through ``targets``, with dissipation control through
+    snap-backs.
+
+    Each target is reached in sub-steps, each tried with ``attempt(u)`` (Newton at the tip
+    displacement u); a sub-step is cut by 4 when that fails or raises the damage of some point
+    by more than ``max_damage_increment``, and grows back by 2 after each success. A sub-step
+    smaller than ``min_fraction`` of the target spacing that still fails means that no
+    equilibrium path is continuous in u (a snap-back: the force must drop while u decreases).
+    The path is then followed by ``arc(tau)``, steps of prescribed dissipated energy tau
+    (Gutierrez 2004; Verhoosel et al. 2009), until u is past the stalled displacement again or
+    the force has vanished (the bar has broken), and displacement control resumes.
+
+    Args:
+        targets: Increasing tip displacements, shape ``(k,)`` [m]; every one is reached exactly.
+        attempt: ``attempt(u) -> trial | None``.
+        accept: ``accept(trial)`` commits a trial (and records the step).
+        arc: ``arc(tau) -> trial | None``, a step that dissipates the energy tau; or ``None``.
+        energy_step: First energy step tau of ``arc`` [J].
+        max_damage_increment: Largest damage growth of a point per displacement sub-step.
+        min_fraction: Smallest sub-step, as a fraction of the target spacing.
+        max_arc_steps: Bound on the dissipation-controlled steps.
+
+    Trials have attributes ``u`` (tip displacement), ``force`` and ``damage_increment`` (max
+    over points vs the last accepted state); ``arc`` steps are cut by 4 like displacement steps
+    when they fail or exceed ``max_damage_increment``.
+
+    Returns:
+        Counters ``{"cuts", "arc_steps"}``.
+
+    Raises:
+        SolverError: The smallest sub-step fails and no (working) ``arc`` is given.
+    """
+    from .errors import SolverError  # noqa: PLC0415
+
+    count = {"cuts": 0, "arc_steps": 0}
+    u, f_max = 0.0, 0.0
+    spacing = np.diff(np.r_[0.0, targets])
+    du = spacing[0]
+    tau = energy_step
+    for target, span in zip(targets, spacing):
+        smallest = min_fraction * span
+        du = min(max(du, smallest), target - u)
+        while u < target:
+            un = target if u + du >= target * (1 - 1e-12) else u + du
+            trial = attempt(un)
+            small = un - u <= smallest * (1 + 1e-9)
+            if trial is not None and (trial.damage_increment <= max_damage_increment or small):
+                accept(trial)
+                f_max = max(f_max, trial.force)
+                u, du = un, 2.0 * (un - u)
+                continue
+            if not small:
+                du = max((un - u) / 4.0, smallest)
+                count["cuts"] += 1
+                continue
+            if arc is None or not tau > 0:
+                raise SolverError(f"no equilibrium found at tip displacement {un:.6g} even with a sub-step of "
+                                  f"{un - u:.3g} (a snap-back); use more steps or check the damage parameters")
+            stall = un
+            while True:
+                trial = arc(tau)
+                if trial is None or trial.damage_increment > max_damage_increment:
+                    tau /= 4.0
+                    if tau < 1e-6 * energy_step:
+                        raise SolverError(f"the dissipation-controlled path stalls at tip displacement {u:.6g}; "
+                                          "use more steps or check the damage parameters")
+                    continue
+                accept(trial)
+                count["arc_steps"] += 1
+                u = trial.u
+                if trial.u >= stall or trial.force <= 1e-6 * f_max or count["arc_steps"] >= max_arc_steps:
+                    break
+                tau = min(2.0 * tau, energy_step)
+            du = smallest
+        du = min(du, span)
+    return count
+
+
+def failure_displacement(u: np.ndarray, force: np.ndarray, rtol: float = 1e-6) -> float:
+    """Tip displacement at which the force first vanishes (complete failure), u_T^max.
+
+    The softening branch of the last two steps with F > rtol max F is extrapolated linearly to
+    F = 0 (exact for the linear softening law (4.2) whatever the step size). Where the force
+    was still rising before it vanished (a snap-back: the bar broke at once), it is the first
+    displacement with F <= rtol max F. NaN if the force never vanishes.
+
+    Args:
+        u: Tip displacements, shape ``(k,)`` [m], starting at 0.
+        force: Forces, shape ``(k,)`` [N].
+    """
+    u, force = np.asarray(u, float), np.asarray(force, float)
+    small = force <= rtol * force.max()
+    small[0] = False
+    if not small.any():
+        return float("nan")
+    j = int(np.argmax(small))  # first vanishing step
+    k = j - 1
+    if k >= 1 and force[k] < force[k - 1]:
+        return float(u[k] + force[k] * (u[k] - u[k - 1]) / (force[k - 1] - force[k]))
+    return float(u[j])

@@ -1,0 +1,120 @@
+"""A cracked bar under tension (seed 4.3.1): the acceptance criteria of the Chapter 4 case."""
+import json
+
+import numpy as np
+import pytest
+
+from rkfx import damage as dm
+from rkfx.cases import cracked_bar
+
+NODES = [16, 32, 64, 128]
+WC = 2 * 1.885 / 200.0  # w_c = 2 G_F / f_t = u_T^max of the cohesive crack (4.9)
+GF_A = 1.885 * 10.0
+
+try:
+    import dolfinx_solver  # noqa: F401
+
+    METHODS = ("rkpm", "fem")
+except ImportError:  # the FEM baseline needs dolfinx
+    METHODS = ("rkpm",)
+
+
+@pytest.fixture(scope="module")
+def seed():
+    """The seed's models (Voronoi cells) at 16/32/64/128 nodes, and the crack-band FEM."""
+    return cracked_bar.run(methods=METHODS, nodes=NODES, cells=["voronoi"])
+
+
+def runs(res, study, cells=None):
+    return {r.info["nodes"]: r for r in res.runs if r.info.get("study") == study
+            and (cells is None or r.info.get("cells") == cells)}
+
+
+@pytest.mark.parametrize("n", NODES)
+def test_regularized_failure_displacement_within_half_a_percent(seed, n):
+    r = runs(seed, "regularized", "voronoi")[n]
+    assert abs(r.errors["u_T_max"] / WC - 1) < 5e-3, r.errors["u_T_max"]
+    # Broken (F = 0) with the energy of the crack: G_F A at the weakened peak 0.999 f_t A.
+    assert r.errors["F_end_over_ft_A"] < 1e-6
+    assert abs(r.errors["dissipated"] / (0.999 * GF_A) - 1) < 5e-3
+    assert abs(r.errors["work_balance_rel"]) < 1e-3
+
+
+def test_summary_maps_node_counts_to_failure_displacements(seed):
+    summary = next(r for r in seed.runs if r.method == "rkpm-scni" and r.info["study"] == "summary")
+    assert set(summary.series["u_T_max"]) == {str(n) for n in NODES}
+
+
+def test_crack_opening_follows_the_cohesive_law(seed):
+    for r in runs(seed, "regularized", "voronoi").values():
+        w, w_czm = np.asarray(r.series["cod"]), np.asarray(r.series["w_czm"])
+        assert np.abs(w - w_czm).max() < 2e-3 * WC
+
+
+def test_unregularized_energy_decreases_with_refinement(seed):
+    unreg = runs(seed, "unregularized")
+    energy = [unreg[n].errors["dissipated"] for n in NODES]
+    assert all(a > 1.5 * b for a, b in zip(energy, energy[1:])), energy
+    # Equal kappa_c at 16 nodes: the same model as the regularized one there.
+    assert np.isclose(energy[0], runs(seed, "regularized", "voronoi")[16].errors["dissipated"], rtol=1e-6)
+    # Every model breaks (the fine ones through their snap-back).
+    assert all(unreg[n].errors["F_end_over_ft_A"] < 1e-6 for n in NODES)
+
+
+def test_damage_reaches_one_in_the_band_at_the_cohesive_failure_displacement(seed):
+    for r in runs(seed, "regularized", "voronoi").values():
+        damage = np.asarray(r.series["damage_profile"])
+        assert np.sort(damage)[-2:].min() > 0.999 and np.sort(damage)[-3] == 0.0
+
+
+def test_scni_stress_is_nearly_constant_while_gauss_oscillates(seed):
+    """Fig 4.11. SCNI is exact while elastic (patch test) and keeps a ~0.2% odd-even ripple
+    after damage onset (not the 1e-6 hoped for: see the case docstring); Gauss points with
+    direct gradients oscillate by ~16%."""
+    scni, gauss = runs(seed, "regularized", "voronoi"), runs(seed, "stress")
+    for n in NODES:
+        assert gauss[n].errors["stress_max_dev"] > 1e-2
+        assert scni[n].errors["stress_max_dev"] < 5e-3
+        assert scni[n].errors["stress_max_dev"] < gauss[n].errors["stress_max_dev"] / 20
+
+
+@pytest.mark.skipif("fem" not in METHODS, reason="needs dolfinx")
+@pytest.mark.parametrize("n", NODES)
+def test_crack_band_fem_failure_displacement_within_one_percent(seed, n):
+    r = runs(seed, "fem")[n]
+    assert abs(r.errors["u_T_max"] / WC - 1) < 1e-2
+    assert abs(r.errors["dissipated"] / (0.999 * GF_A) - 1) < 5e-3
+
+
+def test_median_dual_cells_break_late():
+    """With rkfx's median-dual cells the four band particles open unequally (1.32 : 0.68), so
+    the second pair fails late: u_T^max ~ 1.47 w_c, at the same energy G_F A."""
+    s = cracked_bar.strip(100.0, 10.0, 32, "median-dual")
+    material = dm.DamageMaterial(2.0e6, 0.0, 200.0, 1.885, "stress")
+    model = dm.damage_model(material, s.volume, np.where(cracked_bar.weak_points(s, 100.0), 0.999, 1.0),
+                            geometry=s.geometry)
+    assert cracked_bar.weak_points(s, 100.0).sum() == 4
+    u_peak = cracked_bar.elastic_limit(s, model)
+    path = cracked_bar.load_path(s, model, cracked_bar._targets(u_peak, WC, 60, 1.6))
+    assert 1.4 < dm.failure_displacement(path.u, path.force) / WC < 1.55
+    assert abs(path.dissipated[-1] / (0.999 * GF_A) - 1) < 5e-3
+
+
+def test_cli_quick(tmp_path):
+    pytest.importorskip("dolfinx_solver")
+    assert cracked_bar.main(["--quick", "--out", str(tmp_path)]) == 0
+    data = json.loads((tmp_path / "results.json").read_text())
+    summary = {r["method"]: r for r in data["runs"] if r["info"]["study"] == "summary"}
+    assert set(summary) == {"rkpm-scni", "rkpm-scni-unregularized", "fem-crack-band"}
+    for r in summary.values():
+        assert set(r["series"]["u_T_max"]) == {"16", "32"}
+    for name in ("load_displacement", "crack_opening", "damage_profile", "stress_gauss_vs_scni", "dissipated_energy"):
+        assert (tmp_path / f"{name}.png").exists()
+
+
+@pytest.mark.parametrize("setting, name", [("GF=-1", "GF"), ("bogus=1", "bogus"), ("nodes=15", "nodes")])
+def test_bad_parameters_exit_2_with_one_line(capsys, setting, name):
+    with pytest.raises(SystemExit) as e:
+        cracked_bar.main(["--set", setting])
+    err = capsys.readouterr().err
+    assert e.value.code == 2 and name in err and err.count("\n") == 1
