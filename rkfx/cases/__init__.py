@@ -9,4 +9,10 @@ live in ``rkfx.cases._cli``.
     plate_with_hole   Kirsch plate with a circular hole under remote tension (plane strain):
                       RKPM (MSCNI / SCNI / DNI) and FEM (P1 / P2) on the same gmsh mesh, errors
                       and rates against the exact solution, stress concentration at the hole.
+    mandel            Mandel's problem (seed 3.4.2): u-p variants, Taylor-Hood and Q1-Q1, the
+                      Mandel-Cryer effect and the early-time oscillation study.
+    terzaghi          Terzaghi's consolidation (seed 3.4.1): first-step profiles, refinement.
+    strip_load        strip load on a consolidating half-space (seed 3.4.3), graded nodes.
+    cracked_bar       damage particle method on a bar in tension (seed 4.3.1): regularized vs
+                      unregularized, crack-band FEM, Gauss vs SCNI stress.
 """
