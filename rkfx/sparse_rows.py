@@ -45,8 +45,12 @@ class SparseRows:
         return SparseRows(self.indptr, self.indices, self.data[:, k:k + 1], self.num_cols)
 
     def matrix(self, k: int = 0) -> sp.csr_matrix:
-        """Component k as a ``(num_rows, num_cols)`` scipy CSR matrix."""
-        return sp.csr_matrix((self.data[:, k], self.indices, self.indptr),
+        """Component k as a ``(num_rows, num_cols)`` scipy CSR matrix.
+
+        The matrix owns copies of the index arrays: scipy sorts indices in place, which would
+        otherwise scramble the rows shared by the other components.
+        """
+        return sp.csr_matrix((self.data[:, k].copy(), self.indices.copy(), self.indptr.copy()),
                              shape=(self.num_rows, self.num_cols))
 
     def __matmul__(self, coefficients: np.ndarray) -> np.ndarray:

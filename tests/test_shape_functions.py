@@ -50,3 +50,14 @@ def test_neighbour_count_is_bounded_under_refinement():
         rows = evaluate(rk_approximation(p.x, p.spacing), p.x)
         counts.append(np.diff(rows.indptr).mean())
     assert max(counts) < 12 and max(counts) / min(counts) < 1.3
+
+
+def test_component_matrices_do_not_share_index_arrays():
+    """Sorting one component's matrix in place must leave the rows of the others intact."""
+    p = unit_square(0.2)
+    rows = evaluate(rk_approximation(p.x, p.spacing), random_points(p, 50), gradients=True)
+    before = rows.matrix(1).toarray()
+    m0 = rows.matrix(0)
+    m0.sort_indices()
+    m0.max()
+    assert np.array_equal(rows.matrix(1).toarray(), before)
