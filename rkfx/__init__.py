@@ -13,6 +13,8 @@ The numerical core (this package's top-level modules) needs only numpy, scipy an
     elastostatics    plane-strain solver
     poroelasticity   equal-order u-p Biot solver: NI/SCNI with pressure projection (chapter 3)
     damage           damage particle method: Mazars strain, damage law, energy regularization (ch. 4)
+    cracks           pre-existing cracks: diffraction of the kernel supports round crack tips
+    explicit         central-difference dynamics with lumped mass, constraints, checkpoints
     crack_tracking   candidate damage particles along crack segments (eq. 4.22)
     linear_solver    factorized systems through PETSc when installed, else SciPy
     warmup           compile the kernels before timing

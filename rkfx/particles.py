@@ -307,3 +307,138 @@ def _in_polygon(pts: np.ndarray, poly: np.ndarray, tol: float) -> np.ndarray:
             s = np.clip((pts - p) @ t / (t @ t), 0.0, 1.0)
             near |= np.linalg.norm(pts - (p + s[:, None] * t), axis=1) <= tol
     return inside | near
+
+
+def cut_triangulation(p: Particles, polylines, gap: float | None = None, name: str = "crack",
+                      exponent: float = 2.0):
+    """Split a node set along pre-existing cracks, so no triangle straddles them.
+
+    The cracks must run along triangulation edges (a structured grid split along a grid
+    line, or a gmsh mesh with the crack lines embedded in the surface). Every node on a crack
+    except a free tip is duplicated, one copy per side: the triangles around the node are
+    grouped by the crack edges between them, each group gets its own copy, and each copy
+    is moved off the crack line by ``gap`` towards its side. The result is a domain with a
+    thin slit: its faces are boundary edges tagged ``name`` (traction-free unless loaded),
+    the median-dual cells on either side do not overlap, and RK nodes are never on the crack
+    (where the diffraction criterion could not tell the sides apart). A polyline end counts
+    as a free tip unless it lies on the boundary; cracks may kink, and where they meet each
+    wedge gets its own copy (the tip flags of ``cracks`` then need a look).
+
+    Args:
+        p: Particles with the crack lines among the triangulation edges.
+        polylines: Vertices of each crack, shapes ``(m_k >= 2, 2)`` [m].
+        gap: Distance of the face copies from the crack line [m]; default 1e-8 times the
+            smallest nodal spacing on the cracks. The faces next to a tip are inclined by
+            gap / h, which perturbs the solution by O(gap / h); round-off needs gap to stay well
+            above 1e-16 |x|.
+        name: Boundary part name of the crack faces.
+        exponent: lambda of the diffraction distance of the returned cracks.
+
+    Returns:
+        ``(particles, cracks)``: the split set (new nodes appended; nodal spacing kept) and
+        the ``rkfx.cracks.Cracks`` to give ``rk_approximation``.
+
+    Raises:
+        InputError: A crack does not run along triangulation edges.
+    """
+    from .cracks import cracks as make_cracks  # noqa: PLC0415
+
+    x, tri, n = p.x, p.triangles, p.num_nodes
+    scale = float(np.ptp(x, axis=0).max())
+    tol = 1e-9 * scale
+    lines = [np.asarray(v, dtype=np.float64).reshape(-1, 2) for v in polylines]
+    on_boundary = _near_segments(np.array([v[[0, -1]] for v in lines]).reshape(-1, 2),
+                                 x[p.boundary_edges].reshape(-1, 2, 2), tol).reshape(-1, 2)
+    c = make_cracks(lines, [(not a, not b) for a, b in on_boundary], exponent)
+    # Crack edges: triangulation edges whose ends and midpoint lie on a crack segment.
+    e = p.edges
+    on = _near_segments(x, c.segments, tol)
+    cand = e[on[e[:, 0]] & on[e[:, 1]]]
+    cand = cand[_near_segments(x[cand].mean(axis=1), c.segments, tol)]
+    covered = np.linalg.norm(x[cand[:, 0]] - x[cand[:, 1]], axis=1).sum()
+    length = np.linalg.norm(c.segments[:, 1] - c.segments[:, 0], axis=1).sum()
+    if not abs(covered - length) <= 1e-6 * length:
+        raise InputError(f"the cracks (total length {length:.6g}) run along only {covered:.6g} of "
+                         "triangulation edges; put nodes on the crack lines (a grid line of a structured "
+                         "grid, or gmsh.model.mesh.embed of the crack curves) and end cracks at nodes")
+    cand = np.sort(cand, axis=1)
+    crack_key = set(map(tuple, cand.tolist()))
+    if gap is None:
+        gap = 1e-8 * float(p.spacing[np.unique(cand)].min())
+    # Triangles around each crack node, grouped across the non-crack edges at the node.
+    new_tri = tri.copy()
+    xn = x.copy()
+    extra_x, extra_h = [], []
+    normals = c.segments[:, 1] - c.segments[:, 0]
+    normals = np.column_stack([-normals[:, 1], normals[:, 0]]) / np.linalg.norm(normals, axis=1)[:, None]
+    ts_of = {v: [] for v in np.unique(cand).tolist()}
+    for t, k in zip(*np.nonzero(np.isin(tri, list(ts_of)))):
+        ts_of[int(tri[t, k])].append(int(t))
+    for v, ts in ts_of.items():
+        parent = {t: t for t in ts}
+
+        def root(t):
+            while parent[t] != t:
+                t = parent[t]
+            return t
+        by_edge = {}
+        for t in ts:
+            for w in tri[t].tolist():
+                if w != v and (min(v, w), max(v, w)) not in crack_key:
+                    by_edge.setdefault(w, []).append(t)
+        for group in by_edge.values():
+            for t in group[1:]:
+                parent[root(t)] = root(group[0])
+        groups = {}
+        for t in ts:
+            groups.setdefault(root(t), []).append(t)
+        if len(groups) < 2:
+            continue  # a free tip: the crack ends inside the fan
+        # Offset direction: the crack normal at v (mean over its segments), towards the group.
+        nv = normals[_segment_distance(x[v][None], c.segments)[0] <= tol]
+        nv = (nv * np.where(nv @ nv[0] < 0, -1.0, 1.0)[:, None]).mean(axis=0)
+        nv /= np.linalg.norm(nv)
+        for gi, group in enumerate(groups.values()):
+            side = (x[tri[group]].mean(axis=1) - x[v]).mean(axis=0)
+            s_n = side @ nv
+            # Where cracks meet (more than two sides) each copy moves into its own wedge.
+            off = np.sign(s_n) * nv if len(groups) == 2 and abs(s_n) > 1e-6 * np.linalg.norm(side) \
+                else side / np.linalg.norm(side)
+            if gi == 0:
+                node = v
+                xn[v] = x[v] + gap * off
+            else:
+                node = n + len(extra_x)
+                extra_x.append(x[v] + gap * off)
+                extra_h.append(p.spacing[v])
+            for t in group:
+                new_tri[t][tri[t] == v] = node
+    xn = np.vstack([xn, np.array(extra_x).reshape(-1, 2)])
+    # Tagged boundary edges of p, carried over through the triangle side that owns each, plus
+    # the crack faces (both sides of every crack edge).
+    side_keys = np.minimum(tri, np.roll(tri, -1, axis=1)) * n + np.maximum(tri, np.roll(tri, -1, axis=1))
+    new_sides = np.stack([new_tri, np.roll(new_tri, -1, axis=1)], axis=-1)
+    on_bnd = np.bincount(p.triangle_edges.ravel(), minlength=len(p.edges))[p.triangle_edges] == 1
+    bkeys = _edge_keys(p.boundary_edges, n)
+    order = np.argsort(bkeys)
+    side_tag = np.zeros(tri.shape, np.int64)
+    side_tag[on_bnd] = p.boundary_tags[order[np.searchsorted(bkeys[order], side_keys[on_bnd])]]
+    tagged = {nm: new_sides[side_tag == t] for nm, t in p.boundary_names.items()}
+    tagged[name] = new_sides[np.isin(side_keys, cand[:, 0] * n + cand[:, 1])]
+    return particles(xn, new_tri, tagged, np.r_[p.spacing, extra_h]), c
+
+
+def _segment_distance(pts: np.ndarray, segments: np.ndarray) -> np.ndarray:
+    """Distance of each point to each segment, shape ``(num_points, num_segments)``."""
+    a = segments[None, :, 0]
+    d = segments[None, :, 1] - a
+    t = np.clip(np.sum((pts[:, None] - a) * d, axis=-1) / np.sum(d * d, axis=-1), 0.0, 1.0)
+    return np.linalg.norm(pts[:, None] - a - t[..., None] * d, axis=-1)
+
+
+def _near_segments(pts: np.ndarray, segments: np.ndarray, tol: float) -> np.ndarray:
+    """Whether each point lies within ``tol`` of one of the segments, shape ``(num_points,)``."""
+    out = np.zeros(len(pts), bool)
+    for s in range(0, len(segments), 64):  # bounded memory for long boundaries
+        out |= (_segment_distance(pts, segments[s:s + 64]) <= tol).any(axis=1)
+    return out

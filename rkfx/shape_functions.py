@@ -5,13 +5,15 @@ linear (default) or quadratic monomial basis. Values and direct gradients at any
 points come out as CSR rows over the node index (points x neighbours), computed in parallel
 by compiled kernels. The basis is scaled by a length local to each point so that the moment
 matrix stays well conditioned for any node spacing; the shape functions do not depend on
-that scale.
+that scale. Pre-existing cracks (``rkfx.cracks``) cut the supports by the diffraction
+method: only the kernel distance changes, so the reproducing conditions still hold.
 """
 from dataclasses import dataclass
 
 import numba
 import numpy as np
 
+from .cracks import Cracks, blocked, diffracted_distance, kernel_arrays, near_segments
 from .errors import InputError, SingularMomentMatrix, point_str
 from .kernel import cubic_spline
 from .sparse_rows import SparseRows
@@ -29,11 +31,13 @@ class RKApproximation:
         x: Node coordinates, shape ``(num_nodes, 2)`` [m].
         support: Support radius a_I of each node, shape ``(num_nodes,)`` [m].
         order: Degree of the complete monomial basis H (1 linear, 2 quadratic).
+        cracks: Pre-existing cracks cutting the supports (diffraction method), or ``None``.
     """
 
     x: np.ndarray
     support: np.ndarray
     order: int = 1
+    cracks: Cracks | None = None
 
     @property
     def num_nodes(self) -> int:
@@ -41,7 +45,7 @@ class RKApproximation:
 
 
 def rk_approximation(x: np.ndarray, spacing: np.ndarray, support_factor: float = 1.5,
-                     order: int = 1) -> RKApproximation:
+                     order: int = 1, cracks: Cracks | None = None) -> RKApproximation:
     """RK approximation with support a_I = c * h_I.
 
     Args:
@@ -49,6 +53,8 @@ def rk_approximation(x: np.ndarray, spacing: np.ndarray, support_factor: float =
         spacing: Nodal spacing h_I, shape ``(num_nodes,)`` [m].
         support_factor: c > 0; 1.5 is the seed's choice for the linear basis.
         order: 1 (linear) or 2 (quadratic) basis.
+        cracks: Pre-existing cracks (diffraction method); nodes must not lie on them
+            (``rkfx.particles.cut_triangulation`` splits a node set along a crack).
     """
     if not np.isfinite(support_factor) or support_factor <= 0:
         raise InputError(f"support_factor = {support_factor!r} must be positive; use e.g. 1.5 "
@@ -62,7 +68,9 @@ def rk_approximation(x: np.ndarray, spacing: np.ndarray, support_factor: float =
         i = bad[0]
         raise InputError(f"node {i} at {point_str(x[i])} has spacing h = {spacing[i]}; spacings must be "
                          "positive (check for duplicate nodes)")
-    return RKApproximation(x, np.ascontiguousarray(support_factor * spacing), order)
+    if cracks is not None and cracks.num_segments == 0:
+        cracks = None
+    return RKApproximation(x, np.ascontiguousarray(support_factor * spacing), order, cracks)
 
 
 @numba.njit(cache=True)
@@ -98,10 +106,39 @@ def _cholesky_solve(m, rhs, nb):
 
 
 @numba.njit(inline="always")
-def _gather(px, py, x, a, origin, cell, nx, ny, start, order, idx, dxs, dys, phis, dphis, inv):
-    """Nodes covering (px, py) with scaled offsets, kernel values and kernel gradients."""
+def _gather(px, py, x, a, origin, cell, nx, ny, start, order, idx, dxs, dys, phis, dphis, inv,
+            segments, tips, exponent, near):
+    """Nodes covering (px, py) with scaled offsets, kernel values and kernel gradients.
+
+    With crack segments near the point, a node whose straight path to the point is cut gets
+    the diffraction distance of ``rkfx.cracks`` (or is dropped when invisible).
+    """
     x0, x1, y0, y1 = cell_range(px, py, origin, cell, nx, ny)
+    # Segments within one cell (>= every support radius) of the point are all a path of
+    # length < a_J can meet.
+    nnear = near_segments(px, py, cell, segments, near) if segments.shape[0] else 0
     k = 0
+    if nnear == 0:  # the common case, kept free of crack logic
+        for jy in range(y0, y1):
+            for jx in range(x0, x1):
+                cc = jy * nx + jx
+                for q in range(start[cc], start[cc + 1]):
+                    j = order[q]
+                    dx = px - x[j, 0]
+                    dy = py - x[j, 1]
+                    r2 = dx * dx + dy * dy
+                    if r2 < a[j] * a[j]:
+                        r = np.sqrt(r2)
+                        phi, dphi = cubic_spline(r / a[j])
+                        idx[k] = j
+                        dxs[k] = dx * inv
+                        dys[k] = dy * inv
+                        phis[k] = phi
+                        g = dphi / (r * a[j]) if r > 0.0 else 0.0
+                        dphis[k, 0] = g * dx
+                        dphis[k, 1] = g * dy
+                        k += 1
+        return k
     for jy in range(y0, y1):
         for jx in range(x0, x1):
             cc = jy * nx + jx
@@ -112,21 +149,51 @@ def _gather(px, py, x, a, origin, cell, nx, ny, start, order, idx, dxs, dys, phi
                 r2 = dx * dx + dy * dy
                 if r2 < a[j] * a[j]:
                     r = np.sqrt(r2)
-                    phi, dphi = cubic_spline(r / a[j])
+                    if blocked(x[j, 0], x[j, 1], px, py, segments, near, nnear, np.nan, np.nan):
+                        dist, ex, ey = diffracted_distance(px, py, x[j, 0], x[j, 1], r, segments, tips,
+                                                           exponent, near, nnear)
+                        if not dist < a[j]:
+                            continue
+                        phi, dphi = cubic_spline(dist / a[j])
+                        g = dphi / a[j]
+                        dphis[k, 0] = g * ex
+                        dphis[k, 1] = g * ey
+                    else:
+                        phi, dphi = cubic_spline(r / a[j])
+                        g = dphi / (r * a[j]) if r > 0.0 else 0.0
+                        dphis[k, 0] = g * dx
+                        dphis[k, 1] = g * dy
                     idx[k] = j
                     dxs[k] = dx * inv
                     dys[k] = dy * inv
                     phis[k] = phi
-                    g = dphi / (r * a[j]) if r > 0.0 else 0.0
-                    dphis[k, 0] = g * dx
-                    dphis[k, 1] = g * dy
                     k += 1
     return k
 
 
 @numba.njit(parallel=True, cache=True)
+def _count_cut(x, a, points, origin, cell, nx, ny, start, order, segments, tips, exponent, counts):
+    """Lower the Euclidean counts of points near a crack to the nodes actually in reach."""
+    m = points.shape[0]
+    kmax = 0
+    for p in range(m):
+        kmax = max(kmax, counts[p])
+    for c in numba.prange((m + CHUNK - 1) // CHUNK):
+        idx = np.empty(kmax, np.int64)
+        dxs = np.empty(kmax)
+        dys = np.empty(kmax)
+        phis = np.empty(kmax)
+        dphis = np.empty((kmax, 2))
+        near = np.empty(segments.shape[0], np.int64)
+        for p in range(c * CHUNK, min(m, (c + 1) * CHUNK)):
+            if near_segments(points[p, 0], points[p, 1], cell, segments, near):
+                counts[p] = _gather(points[p, 0], points[p, 1], x, a, origin, cell, nx, ny, start, order,
+                                    idx, dxs, dys, phis, dphis, 1.0, segments, tips, exponent, near)
+
+
+@numba.njit(parallel=True, cache=True)
 def _rows_linear(x, a, points, scale, origin, cell, nx, ny, start, order, indptr, with_grad,
-                 indices, out, ratio):
+                 segments, tips, exponent, indices, out, ratio):
     """Linear-basis RK rows in closed form (3 x 3 moment matrix by cofactors)."""
     m = points.shape[0]
     kmax = 0
@@ -138,10 +205,11 @@ def _rows_linear(x, a, points, scale, origin, cell, nx, ny, start, order, indptr
         dys = np.empty(kmax)
         phis = np.empty(kmax)
         dphis = np.empty((kmax, 2))
+        near = np.empty(segments.shape[0], np.int64)
         for p in range(c * CHUNK, min(m, (c + 1) * CHUNK)):
             inv = 1.0 / scale[p]
             n = _gather(points[p, 0], points[p, 1], x, a, origin, cell, nx, ny, start, order,
-                        idx, dxs, dys, phis, dphis, inv)
+                        idx, dxs, dys, phis, dphis, inv, segments, tips, exponent, near)
             m00 = m01 = m02 = m11 = m12 = m22 = 0.0
             for k in range(n):
                 f = phis[k]
@@ -220,7 +288,7 @@ def _basis(u, v, order, h):
 
 @numba.njit(parallel=True, cache=True)
 def _rows_generic(x, a, points, scale, origin, cell, nx, ny, start, order, indptr, with_grad,
-                  basis_order, indices, out, ratio):
+                  basis_order, segments, tips, exponent, indices, out, ratio):
     """RK rows for any basis order: moment matrix (3.24) solved by Cholesky."""
     nb = 3 if basis_order == 1 else 6
     m = points.shape[0]
@@ -238,10 +306,11 @@ def _rows_generic(x, a, points, scale, origin, cell, nx, ny, start, order, indpt
         fac = np.empty((nb, nb))
         rhs = np.empty((nb, 3))
         h = np.empty((3, nb))
+        near = np.empty(segments.shape[0], np.int64)
         for p in range(c * CHUNK, min(m, (c + 1) * CHUNK)):
             inv = 1.0 / scale[p]
             n = _gather(points[p, 0], points[p, 1], x, a, origin, cell, nx, ny, start, order,
-                        idx, dxs, dys, phis, dphis, inv)
+                        idx, dxs, dys, phis, dphis, inv, segments, tips, exponent, near)
             mom[:] = 0.0
             dmom[:] = 0.0
             for k in range(n):
@@ -312,6 +381,10 @@ def evaluate(rk: RKApproximation, points: np.ndarray, gradients: bool = False) -
     g = cell_grid(rk.x, rk.support, points)
     grid = (g.origin, g.cell, *g.shape, g.start, g.order)
     counts = count_covering(rk.x, rk.support, points, *grid)
+    cut = kernel_arrays(rk.cracks)
+    if rk.cracks is not None:
+        # The Euclidean search over-counts nodes that a crack hides or diffracts out of reach.
+        _count_cut(rk.x, rk.support, points, *grid, *cut, counts)
     indptr = np.zeros(len(points) + 1, np.int64)
     np.cumsum(counts, out=indptr[1:])
     nnz = int(indptr[-1])
@@ -321,10 +394,10 @@ def evaluate(rk: RKApproximation, points: np.ndarray, gradients: bool = False) -
     # Basis scale: any length of the order of the supports; N_I does not depend on it.
     scale = np.full(len(points), float(np.median(rk.support)))
     if rk.order == 1:
-        _rows_linear(rk.x, rk.support, points, scale, *grid, indptr, gradients,
+        _rows_linear(rk.x, rk.support, points, scale, *grid, indptr, gradients, *cut,
                      indices, out, ratio)
     else:
-        _rows_generic(rk.x, rk.support, points, scale, *grid, indptr, gradients, rk.order,
+        _rows_generic(rk.x, rk.support, points, scale, *grid, indptr, gradients, rk.order, *cut,
                       indices, out, ratio)
     bad = np.flatnonzero(~(ratio >= RCOND_MIN))
     if bad.size:
