@@ -118,27 +118,6 @@ def _gather(px, py, x, a, origin, cell, nx, ny, start, order, idx, dxs, dys, phi
     # length < a_J can meet.
     nnear = near_segments(px, py, cell, segments, near) if segments.shape[0] else 0
     k = 0
-    if nnear == 0:  # the common case, kept free of crack logic
-        for jy in range(y0, y1):
-            for jx in range(x0, x1):
-                cc = jy * nx + jx
-                for q in range(start[cc], start[cc + 1]):
-                    j = order[q]
-                    dx = px - x[j, 0]
-                    dy = py - x[j, 1]
-                    r2 = dx * dx + dy * dy
-                    if r2 < a[j] * a[j]:
-                        r = np.sqrt(r2)
-                        phi, dphi = cubic_spline(r / a[j])
-                        idx[k] = j
-                        dxs[k] = dx * inv
-                        dys[k] = dy * inv
-                        phis[k] = phi
-                        g = dphi / (r * a[j]) if r > 0.0 else 0.0
-                        dphis[k, 0] = g * dx
-                        dphis[k, 1] = g * dy
-                        k += 1
-        return k
     for jy in range(y0, y1):
         for jx in range(x0, x1):
             cc = jy * nx + jx
@@ -149,7 +128,8 @@ def _gather(px, py, x, a, origin, cell, nx, ny, start, order, idx, dxs, dys, phi
                 r2 = dx * dx + dy * dy
                 if r2 < a[j] * a[j]:
                     r = np.sqrt(r2)
-                    if blocked(x[j, 0], x[j, 1], px, py, segments, near, nnear, np.nan, np.nan):
+                    # No crack near the point (the common case) costs one integer test.
+                    if nnear > 0 and blocked(x[j, 0], x[j, 1], px, py, segments, near, nnear, np.nan, np.nan):
                         dist, ex, ey = diffracted_distance(px, py, x[j, 0], x[j, 1], r, segments, tips,
                                                            exponent, near, nnear)
                         if not dist < a[j]:
