@@ -5,6 +5,7 @@ The numerical core (this package's top-level modules) needs only numpy, scipy an
     particles        nodes, spacing, background triangulation, named boundaries
     gmsh_nodes       particles from gmsh models and .geo files (needs gmsh)
     nodal_domains    conforming median-dual cells, subcells, boundary segments
+    grid_cells       rectangular Voronoi cells of tensor grids, with slits along cell faces
     shape_functions  RK shape functions and direct gradients (eqs. 3.17-3.25)
     quadrature       Gauss, DNI, SCNI and MSCNI rules as sparse rows (eqs. 3.55-3.56)
     operators        B^T D B w products: stiffness, diffusion, mass, loads
@@ -16,6 +17,7 @@ The numerical core (this package's top-level modules) needs only numpy, scipy an
     cracks           pre-existing cracks: diffraction of the kernel supports round crack tips
     explicit         central-difference dynamics with lumped mass, constraints, checkpoints
     crack_tracking   candidate damage particles along crack segments (eq. 4.22)
+    explicit_damage  damage particle method in explicit dynamics: compiled update, runs kept on disk
     linear_solver    factorized systems through PETSc when installed, else SciPy
     warmup           compile the kernels before timing
 

@@ -43,6 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import InputError
+from .nodal_domains import NodalDomains
 from .particles import Particles
 
 PLANES = ("strain", "stress")
@@ -225,7 +226,8 @@ class CellGeometry:
         node: Node L of each subcell, shape ``(num_subcells,)``.
         vertices: Counter-clockwise vertices (x_L, m_k, g, m_k-1) of each subcell, shape
             ``(num_subcells, 4, 2)`` [m]: the node, the midpoint of triangle side k, the
-            triangle's centroid and the midpoint of side k-1 (as in ``rkfx.nodal_domains``).
+            triangle's centroid and the midpoint of side k-1 (as in ``rkfx.nodal_domains``);
+            for grid cells the node, a cell-side point, the cell corner, a cell-side point.
         num_nodes: Number of nodes.
     """
 
@@ -234,8 +236,21 @@ class CellGeometry:
     num_nodes: int
 
 
-def cell_geometry(p: Particles) -> CellGeometry:
-    """Subcell quadrilaterals of the median-dual nodal domains of ``p`` (subcell 3t + k)."""
+def cell_geometry(p: Particles | NodalDomains) -> CellGeometry:
+    """Subcell quadrilaterals of the nodal domains.
+
+    Args:
+        p: ``Particles``: their median-dual cells (subcell 3t + k); or ``NodalDomains``
+            carrying ``subcell_vertices`` (e.g. ``rkfx.grid_cells.grid_domains``): its subcells.
+
+    Raises:
+        InputError: ``NodalDomains`` without ``subcell_vertices``.
+    """
+    if isinstance(p, NodalDomains):
+        if p.subcell_vertices is None:
+            raise InputError("these nodal domains carry no subcell_vertices; pass the Particles for "
+                             "median-dual cells, or build the domains with rkfx.grid_cells.grid_domains")
+        return CellGeometry(p.subcell_node, p.subcell_vertices, len(p.area))
     tri = p.triangles
     v = p.x[tri]                                # (t, 3, 2)
     nxt = p.x[np.roll(tri, -1, axis=1)]         # vertex k + 1
@@ -314,6 +329,10 @@ class DamageModel:
             ``geometry``), or ``None`` for the unregularized model.
         kappa_c: Critical strain per point of the unregularized model, shape ``(m,)``, or
             ``None`` when regularized.
+        band_factor: Regularized kappa_c = band_factor (G_F / f_t) A_L / V_L. 1 for particles
+            (4.28): a crack runs between two particles' cells and each dissipates G_F A_L / 2.
+            2 for a crack band one element wide (Bazant and Oh): kappa_c = 2 G_F / (f_t h_e)
+            with the band width h_e = V_L / A_L, so that one failed element dissipates G_F A_L.
     """
 
     material: DamageMaterial
@@ -321,6 +340,7 @@ class DamageModel:
     kappa0: np.ndarray
     geometry: CellGeometry | None
     kappa_c: np.ndarray | None
+    band_factor: float = 1.0
 
     @property
     def num_points(self) -> int:
@@ -333,8 +353,8 @@ class DamageModel:
 
 def damage_model(material: DamageMaterial, volume: np.ndarray, kappa0_factor: np.ndarray | float = 1.0,
                  geometry: CellGeometry | None = None, kappa_c: np.ndarray | float | None = None,
-                 regularized: bool = True) -> DamageModel:
-    """Validated ``DamageModel``.
+                 regularized: bool = True, band_factor: float = 1.0) -> DamageModel:
+    """Validated ``DamageModel`` (``band_factor``: see ``DamageModel``).
 
     Args:
         material: Material constants.
@@ -359,7 +379,9 @@ def damage_model(material: DamageMaterial, volume: np.ndarray, kappa0_factor: np
             raise InputError("the regularized model (4.28) needs the cell geometry: pass geometry=cell_geometry(p)")
         if geometry.num_nodes != m:
             raise InputError(f"geometry has {geometry.num_nodes} nodes but {m} damage points were given")
-        return DamageModel(material, volume, kappa0, geometry, None)
+        if not (np.isfinite(band_factor) and band_factor > 0):
+            raise InputError(f"band_factor = {band_factor!r} must be positive (1 for particles, 2 for a crack band)")
+        return DamageModel(material, volume, kappa0, geometry, None, float(band_factor))
     if kappa_c is None:
         raise InputError("the unregularized model needs a constant kappa_c (> kappa0 = ft / E)")
     kc = np.broadcast_to(np.asarray(kappa_c, float), (m,)).copy()
@@ -462,7 +484,7 @@ def update(model: DamageModel, state: DamageState, strain: np.ndarray, tangent: 
         normal[idx] = np.column_stack([np.cos(theta), np.sin(theta)])
         if model.regularized:
             chord[idx] = chord_lengths(model.geometry, idx, normal[idx])
-            kappa_c[idx] = critical_strain(mat, chord[idx], model.volume[idx])
+            kappa_c[idx] = model.band_factor * critical_strain(mat, chord[idx], model.volume[idx])
         prospective = np.flatnonzero(near & ~new)
         kc_tangent = kappa_c.copy()
         normal[prospective], chord[prospective] = state.normal[prospective], state.chord[prospective]
@@ -543,7 +565,7 @@ def march(targets: np.ndarray, attempt, accept, arc=None, energy_step: float = 0
     Raises:
         SolverError: The smallest sub-step fails and no (working) ``arc`` is given.
     """
-    from .errors import SolverError  # noqa: PLC0415
+    from .errors import SolverError
 
     count = {"cuts": 0, "arc_steps": 0}
     u, f_max = 0.0, 0.0

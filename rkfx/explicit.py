@@ -171,6 +171,37 @@ def _linear_stress(e, c, out):
             out[i, j] = c[j, 0] * e[i, 0] + c[j, 1] * e[i, 1] + c[j, 2] * e[i, 2]
 
 
+def _transpose(rows: SparseRows) -> SparseRows:
+    """The entries of ``rows`` grouped by column (stable: each column's entries in row order)."""
+    n = rows.num_rows
+    row = np.repeat(np.arange(n, dtype=np.int32), np.diff(rows.indptr))
+    perm = np.argsort(rows.indices, kind="stable")
+    ptr_t = np.zeros(rows.num_cols + 1, np.int64)
+    np.cumsum(np.bincount(rows.indices, minlength=rows.num_cols), out=ptr_t[1:])
+    return SparseRows(ptr_t, row[perm], np.ascontiguousarray(rows.data[perm]), n)
+
+
+@dataclass(frozen=True)
+class Stabilization:
+    """The MSCNI stabilization of eq. (3.56) for explicit dynamics.
+
+    Per subcell C of particle L, the strain difference (B~_L - B~_C) d between the cell's
+    smoothed strain and the subcell's, weighted by eps_p A_C: the force
+    sum_C (B~_L - B~_C)^T s_L C (B~_L - B~_C) d eps_p A_C penalizes the zero-energy modes of
+    SCNI (the checkerboards of a nodal grid), with s_L = 1 - D_L under damage.
+
+    Attributes:
+        rows, rows_t: grad~N_I(x_L) - grad~N_I(x_C) per subcell, and transposed.
+        owner: Particle L of each subcell, shape ``(num_subcells,)``.
+        weight: eps_p A_C, shape ``(num_subcells,)`` [m^2].
+    """
+
+    rows: SparseRows
+    rows_t: SparseRows
+    owner: np.ndarray
+    weight: np.ndarray
+
+
 @dataclass(frozen=True)
 class SmearedStrain:
     """The smeared strain operator B~ of eqs. (4.31)-(4.33) and the nodal volumes.
@@ -184,11 +215,13 @@ class SmearedStrain:
         rows: grad~N_I(x_L) per node L, shape ``(n, n)`` with 2 components [1/m].
         rows_t: The same entries grouped by I (the transpose), with components [1/m].
         volume: V_L, shape ``(n,)`` [m^2] (per unit thickness).
+        stabilization: MSCNI subcell terms, or ``None`` (plain SCNI).
     """
 
     rows: SparseRows
     rows_t: SparseRows
     volume: np.ndarray
+    stabilization: Stabilization | None = None
 
     @property
     def num_nodes(self) -> int:
@@ -197,16 +230,20 @@ class SmearedStrain:
     def strain(self, d: np.ndarray) -> np.ndarray:
         """Smeared strains (eps_xx, eps_yy, gamma_xy) at the nodes, shape ``(n, 3)``, for
         interleaved coefficients d of shape ``(2 n,)`` [m]."""
-        out = np.empty((self.num_nodes, 3))
-        _strain(self.rows.indptr, self.rows.indices, self.rows.data, np.ascontiguousarray(d, dtype=np.float64), out)
-        return out
+        return _apply(self.rows, d)
 
     def force(self, stress: np.ndarray) -> np.ndarray:
         """f_int = sum_L B~_L^T Sigma_L V_L (eq. 4.34) for nodal stresses ``(n, 3)`` [Pa]; shape ``(2 n,)`` [N]."""
-        out = np.empty(2 * self.num_nodes)
-        _force(self.rows_t.indptr, self.rows_t.indices, self.rows_t.data,
-               np.ascontiguousarray(stress, dtype=np.float64), self.volume, out)
-        return out
+        return _apply_t(self.rows_t, stress, self.volume)
+
+    def subcell_strain(self, d: np.ndarray) -> np.ndarray:
+        """Strain differences (B~_L - B~_C) d per subcell, shape ``(num_subcells, 3)``."""
+        return _apply(self.stabilization.rows, d)
+
+    def subcell_force(self, stress: np.ndarray) -> np.ndarray:
+        """sum_C (B~_L - B~_C)^T stress_C eps_p A_C for subcell stresses ``(num_subcells, 3)`` [N]."""
+        s = self.stabilization
+        return _apply_t(s.rows_t, stress, s.weight)
 
     @cached_property
     def B(self) -> sp.csr_matrix:
@@ -219,22 +256,38 @@ class SmearedStrain:
         return self.B.T.tocsr()
 
 
-def smeared_strain(p: Particles, rk: RKApproximation, domains: NodalDomains | None = None) -> SmearedStrain:
-    """B~ from the SCNI smoothed gradients on the nodal cells (eq. 3.55 = eq. 4.33)."""
+def _apply(rows: SparseRows, d: np.ndarray) -> np.ndarray:
+    out = np.empty((rows.num_rows, 3))
+    _strain(rows.indptr, rows.indices, rows.data, np.ascontiguousarray(d, dtype=np.float64), out)
+    return out
+
+
+def _apply_t(rows_t: SparseRows, stress: np.ndarray, weight: np.ndarray) -> np.ndarray:
+    out = np.empty(2 * rows_t.num_rows)
+    _force(rows_t.indptr, rows_t.indices, rows_t.data, np.ascontiguousarray(stress, dtype=np.float64), weight, out)
+    return out
+
+
+def smeared_strain(p: Particles, rk: RKApproximation, domains: NodalDomains | None = None,
+                   eps_p: float = 0.0) -> SmearedStrain:
+    """B~ from the SCNI smoothed gradients on the nodal cells (eq. 3.55 = eq. 4.33), with the
+    MSCNI subcell terms of eq. (3.56) when ``eps_p`` > 0 (1 is the usual choice)."""
+    if not (np.isfinite(eps_p) and eps_p >= 0):
+        raise InputError(f"eps_p = {eps_p!r} must be >= 0 (0: plain SCNI, 1: MSCNI)")
     domains = domains or nodal_domains(p)
-    cell = smoothed_gradients(p, rk, domains, subcells=False).cell
-    n = cell.num_rows
-    row = np.repeat(np.arange(n, dtype=np.int32), np.diff(cell.indptr))
-    # Transpose by a stable sort on the node index (entries of each I ordered by L).
-    perm = np.argsort(cell.indices, kind="stable")
-    ptr_t = np.zeros(cell.num_cols + 1, np.int64)
-    np.cumsum(np.bincount(cell.indices, minlength=cell.num_cols), out=ptr_t[1:])
-    rows_t = SparseRows(ptr_t, row[perm], np.ascontiguousarray(cell.data[perm]), n)
-    return SmearedStrain(cell, rows_t, np.ascontiguousarray(domains.area, dtype=np.float64))
+    s = smoothed_gradients(p, rk, domains, subcells=eps_p > 0)
+    cell = s.cell
+    stab = None
+    if eps_p > 0:
+        diff = s.cell_minus_subcell
+        stab = Stabilization(diff, _transpose(diff), np.ascontiguousarray(domains.subcell_node),
+                             np.ascontiguousarray(eps_p * domains.subcell_area, dtype=np.float64))
+    return SmearedStrain(cell, _transpose(cell), np.ascontiguousarray(domains.area, dtype=np.float64), stab)
 
 
 def elastic_force(op: SmearedStrain, d_matrix: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
-    """Linear elastic f_int(d) = B~^T V D B~ d, for the elasticity matrix ``d_matrix`` (3, 3) [Pa]."""
+    """Linear elastic f_int(d) = B~^T V D B~ d (plus the MSCNI terms when ``op`` carries them),
+    for the elasticity matrix ``d_matrix`` (3, 3) [Pa]."""
     c = np.asarray(d_matrix, float)
     if c.shape != (3, 3):
         raise InputError(f"elasticity matrix must have shape (3, 3), got {c.shape}")
@@ -245,7 +298,13 @@ def elastic_force(op: SmearedStrain, d_matrix: np.ndarray) -> Callable[[np.ndarr
         e = op.strain(d)
         sigma = np.empty_like(e)
         _linear_stress(e, c, sigma)  # not e @ c.T: BLAS threads would fight numba's
-        return op.force(sigma)
+        f = op.force(sigma)
+        if op.stabilization is not None:
+            e = op.subcell_strain(d)
+            sigma = np.empty_like(e)
+            _linear_stress(e, c, sigma)
+            f += op.subcell_force(sigma)
+        return f
     return f_int
 
 

@@ -66,6 +66,9 @@ class NodalDomains:
         cell_point: Smoothing point of each cell-boundary segment, shape ``(k,)``.
         cell_normal_length: Outward normal x length of each, shape ``(k, 2)`` [m].
         boundary: The domain boundary split at edge midpoints.
+        subcell_vertices: Counter-clockwise vertices of each subcell, vertex 0 the node, shape
+            ``(num_subcells, 4, 2)`` [m], or ``None`` (median-dual cells: see
+            ``rkfx.damage.cell_geometry``).
     """
 
     area: np.ndarray
@@ -80,6 +83,7 @@ class NodalDomains:
     cell_point: np.ndarray
     cell_normal_length: np.ndarray
     boundary: BoundarySegments
+    subcell_vertices: np.ndarray | None = None
 
 
 def _normal_length(p, q):

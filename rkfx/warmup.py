@@ -9,7 +9,13 @@ from functools import cache
 
 @cache
 def warm_up() -> None:
+    import numpy as np
+
+    from .cracks import cracks
+    from .damage import DamageMaterial, cell_geometry, damage_model
     from .elasticity import ElasticMaterial
+    from .explicit import lumped_mass, smeared_strain
+    from .explicit_damage import run_damage
     from .nodal_domains import nodal_domains
     from .operators import stiffness
     from .particles import structured
@@ -25,3 +31,7 @@ def warm_up() -> None:
     s = smoothed_gradients(p, rk, d)
     mscni_stabilization(p, rk, d, s, with_values=True)
     stiffness(integration_rules("dni", p, rk, d), ElasticMaterial(1.0, 0.3).D())
+    crack = cracks([np.array([[0.0, 0.4], [0.5, 0.4]])])
+    evaluate(rk_approximation(p.x, p.spacing, 1.75, cracks=crack), p.x, gradients=True)
+    model = damage_model(DamageMaterial(1.0, 0.3, 1e-3, 1e-3), d.area, geometry=cell_geometry(p))
+    run_damage("warm-up", smeared_strain(p, rk, d), lumped_mass(d.area, 1.0), 1e-3, model, None, (), 2e-3)

@@ -68,14 +68,14 @@ def test_damage_reaches_one_in_the_band_at_the_cohesive_failure_displacement(see
 
 
 def test_scni_stress_is_nearly_constant_while_gauss_oscillates(seed):
-    """Fig 4.11. SCNI is exact while elastic (patch test) and keeps a ~0.2% odd-even ripple
-    after damage onset (not the 1e-6 hoped for: see the case docstring); Gauss points with
+    """Fig 4.11. SCNI is exact while elastic (patch test) and keeps a 2e-4 - 3e-4 odd-even
+    ripple after damage onset (not round-off: see the case docstring); Gauss points with
     direct gradients oscillate by ~16%."""
     scni, gauss = runs(seed, "regularized", "voronoi"), runs(seed, "stress")
     for n in NODES:
         assert gauss[n].errors["stress_max_dev"] > 1e-2
-        assert scni[n].errors["stress_max_dev"] < 5e-3
-        assert scni[n].errors["stress_max_dev"] < gauss[n].errors["stress_max_dev"] / 20
+        assert scni[n].errors["stress_max_dev"] < 1e-3
+        assert scni[n].errors["stress_max_dev"] < gauss[n].errors["stress_max_dev"] / 100
 
 
 @pytest.mark.skipif("fem" not in METHODS, reason="needs dolfinx")

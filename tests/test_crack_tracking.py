@@ -2,45 +2,57 @@
 import numpy as np
 import pytest
 
-from rkfx.crack_tracking import candidates, neighbour_graph, principal_direction
+from rkfx.crack_tracking import principal_direction, tracking
 from rkfx.errors import InputError
 from rkfx.particles import structured
 
 
-def test_neighbours_of_an_interior_grid_node():
-    p = structured(4.0, 4.0, 5, 5)
-    g = neighbour_graph(p)
-    centre = 12
-    nbrs = set(g.indices[g.indptr[centre]:g.indptr[centre + 1]])
-    # One diagonal direction of the triangulation: 4 axis neighbours and 2 diagonal ones.
-    assert {7, 11, 13, 17} <= nbrs and len(nbrs) == 6
+@pytest.fixture(scope="module")
+def square():
+    p = structured(1.0, 1.0, 11, 11)
+    return (p,)
 
 
-@pytest.mark.parametrize("tol, expected_count", [(0.3, 2), (0.8, 4)])
-def test_candidates_lie_along_the_crack_segment(tol, expected_count):
-    p = structured(4.0, 4.0, 5, 5)
-    g = neighbour_graph(p)
-    damaged = np.zeros(p.num_nodes, bool)
-    damaged[12] = True
-    normal = np.zeros((p.num_nodes, 2))
-    normal[12] = (0.0, 1.0)  # horizontal crack segment
-    allowed = candidates(p.x, g, damaged, normal, tol)
-    new = np.flatnonzero(allowed & ~damaged)
-    assert len(new) == expected_count
-    assert {11, 13} <= set(new)  # left and right of the crack tip
-    assert not allowed[7] and not allowed[17]  # across the crack: prevention zone
+def test_candidates_lie_along_the_crack_within_the_tolerance(square):
+    p, = square
+    h = 0.1
+    track = tracking(p.x, p.spacing, 0.3, radius=3.5)
+    centre = int(np.argmin(np.linalg.norm(p.x - 0.5, axis=1)))
+    cand = track.candidates(np.array([centre]), np.array([[0.0, 1.0]]))  # horizontal crack
+    d = p.x[cand] - p.x[centre]
+    assert centre not in cand
+    assert np.all(np.abs(d[:, 1]) / np.linalg.norm(d, axis=1) < 0.3)
+    assert np.all(np.linalg.norm(d, axis=1) < 3.5 * h + 1e-12)
+    # Along the row: the 3 nearest on either side; off the row: (3, 1) at 18.4 degrees is out.
+    assert sorted(np.round(d[:, 0] / h).astype(int)) == [-3, -2, -1, 1, 2, 3]
 
 
-def test_tracking_off_allows_everything_and_seeds_are_allowed():
-    p = structured(2.0, 2.0, 3, 3)
-    g = neighbour_graph(p)
-    none = np.zeros(p.num_nodes, bool)
-    assert candidates(p.x, g, none, np.zeros((9, 2)), 0.3, tracking=False).all()
-    seeds = none.copy()
-    seeds[4] = True
-    assert np.array_equal(candidates(p.x, g, none, np.zeros((9, 2)), 0.3, seeds=seeds), seeds)
+def test_a_narrow_neighbourhood_follows_only_lattice_directions():
+    """1.5 h: side and diagonal neighbours; a crack at 70 degrees (normal at -20) finds none
+    within tol = 0.3, one along a grid line finds its two side neighbours."""
+    p = structured(1.0, 1.0, 11, 11)
+    track = tracking(p.x, p.spacing, 0.3, radius=1.5)
+    centre = 60
+    assert len(track.indices[track.indptr[centre]:track.indptr[centre + 1]]) == 8
+    t = np.radians(-20.0)
+    assert track.candidates(np.array([centre]), np.array([[np.cos(t), np.sin(t)]])).size == 0
+    assert sorted(track.candidates(np.array([centre]), np.array([[1.0, 0.0]]))) == [49, 71]
+
+
+def test_seeds_and_switch():
+    p = structured(1.0, 1.0, 11, 11)
+    track = tracking(p.x, p.spacing, 0.5, seeds=np.array([3, 7]), enabled=False)
+    assert np.flatnonzero(track.seeds).tolist() == [3, 7] and not track.enabled
+
+
+def test_bad_tracking_input(square):
+    p, = square
     with pytest.raises(InputError, match="tol"):
-        candidates(p.x, g, none, np.zeros((9, 2)), 0.0)
+        tracking(p.x, p.spacing, 0.0)
+    with pytest.raises(InputError, match="radius"):
+        tracking(p.x, p.spacing, 0.3, radius=0.5)
+    with pytest.raises(InputError, match="seeds"):
+        tracking(p.x, p.spacing, 0.3, seeds=np.zeros(3, bool))
 
 
 def test_principal_direction():

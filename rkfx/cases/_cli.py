@@ -144,8 +144,9 @@ def _rank() -> int:
 
 
 def build_parser(name: str, doc: str | None, specs: Mapping[str, Param],
-                 quick: Mapping[str, Any] | None = None) -> argparse.ArgumentParser:
-    """The shared parser; ``--help`` lists the parameters with defaults and docs."""
+                 quick: Mapping[str, Any] | None = None, checkpoints: bool = False) -> argparse.ArgumentParser:
+    """The shared parser; ``--help`` lists the parameters with defaults and docs. Long
+    explicit cases (``checkpoints``) also take ``--checkpoint-every N`` and ``--resume DIR``."""
     lines = ["parameters (--set NAME=VALUE):"]
     width = max(len(k) for k in specs) if specs else 0
     for k, v in specs.items():
@@ -162,6 +163,12 @@ def build_parser(name: str, doc: str | None, specs: Mapping[str, Param],
                         help="override parameters (--set a=1 b=2 or --set a=1 --set b=2)")
     parser.add_argument("--out", type=Path, default=Path("results") / name,
                         help=f"output directory (default results/{name}/)")
+    if checkpoints:
+        parser.add_argument("--checkpoint-every", type=int, default=0, metavar="N",
+                            help="write a checkpoint every N time steps (into OUT/checkpoints/)")
+        parser.add_argument("--resume", type=Path, default=None, metavar="DIR",
+                            help="continue a killed run from the output directory DIR: finished models are "
+                                 "read back, the interrupted one continues from its last checkpoint")
     return parser
 
 
@@ -171,19 +178,31 @@ def _fmt_value(v):
 
 def main(name: str, doc: str | None, specs: Mapping[str, Param], run: Callable[..., Results],
          plot: Callable[[Results, Path], Sequence[Path]] | None = None, argv: Sequence[str] | None = None,
-         quick: Mapping[str, Any] | None = None) -> int:
+         quick: Mapping[str, Any] | None = None, checkpoints: bool = False) -> int:
     """Parse ``argv``, call ``run(methods=..., **params)``, write results.json, plot, print the table.
+
+    With ``checkpoints`` the case's ``run`` also receives ``checkpoint_every``, ``work_dir``
+    (``OUT/checkpoints``) and ``resume`` (``DIR/checkpoints`` or ``None``).
 
     Returns:
         0 on success. Bad parameters and ``InputError`` raise ``SystemExit(2)`` after a one-line
         message on stderr.
     """
-    parser = build_parser(name, doc, specs, quick)
+    parser = build_parser(name, doc, specs, quick, checkpoints)
     args = parser.parse_args(argv)
     try:
         params = parse_params(specs, args.overrides, quick if args.quick else None)
+        extra = {}
+        if checkpoints:
+            if args.checkpoint_every < 0:
+                raise ParameterError(f"--checkpoint-every {args.checkpoint_every}: use a positive step count (0: none)")
+            if args.resume is not None and not (args.resume / "checkpoints").is_dir():
+                raise ParameterError(f"--resume {args.resume}: no checkpoints/ folder there; give the --out "
+                                     "directory of the interrupted run")
+            extra = {"checkpoint_every": args.checkpoint_every, "work_dir": Path(args.out) / "checkpoints",
+                     "resume": None if args.resume is None else args.resume / "checkpoints"}
         warm_up()  # wall times below measure the methods, not the JIT compiler
-        results = run(methods=METHODS[args.method], **params)
+        results = run(methods=METHODS[args.method], **params, **extra)
     except (InputError, SolverError) as err:
         _fail(parser.prog, err)
     if _rank() != 0:
@@ -243,7 +262,7 @@ def summary_table(results: Results) -> str:
     rows = [[r.method, *(_cell(r.info.get(k)) for k in info), str(r.n_dofs), f"{r.wall_time_s:.2f}",
              *(_cell(r.errors.get(k)) for k in errs)] for r in results.runs]
     widths = [max(len(c) for c in col) for col in zip(head, *rows)]
-    fmt = lambda row: "  ".join(c.rjust(w) if i else c.ljust(w) for i, (c, w) in enumerate(zip(row, widths)))  # noqa: E731
+    fmt = lambda row: "  ".join(c.rjust(w) if i else c.ljust(w) for i, (c, w) in enumerate(zip(row, widths)))
     title = f"{results.case}: " + ", ".join(f"{k}={_fmt_value(v)}" for k, v in results.params.items())
     return "\n".join([textwrap.shorten(title, 200), fmt(head), "  ".join("-" * w for w in widths),
                       *map(fmt, rows)])
@@ -265,7 +284,7 @@ def progress(iterable: Iterable, desc: str = "", total: int | None = None) -> It
     if not sys.stderr.isatty() or _rank() != 0:
         return iterable
     try:
-        from tqdm import tqdm  # noqa: PLC0415
+        from tqdm import tqdm
     except ImportError:
         return iterable
     return tqdm(iterable, desc=desc, total=total, leave=False)
@@ -285,10 +304,10 @@ def method_style(method: str) -> tuple[str, str]:
 
 def pyplot():
     """``matplotlib.pyplot`` on the non-interactive Agg backend (figures are files, no display)."""
-    import matplotlib  # noqa: PLC0415
+    import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt  # noqa: PLC0415
+    import matplotlib.pyplot as plt
 
     return plt
 
@@ -297,7 +316,7 @@ def save(fig, path: Path, dpi: int = 130) -> Path:
     """Write a figure and close it."""
     fig.savefig(path, dpi=dpi)
     fig.clf()
-    import matplotlib.pyplot as plt  # noqa: PLC0415
+    import matplotlib.pyplot as plt
 
     plt.close(fig)
     return path

@@ -22,8 +22,10 @@ gradient rows (4.33), the stress (4.30) and the damage live at the particles, an
 f_int = sum_L B~^T Sigma V_L. The nodal cells are
 
 * ``voronoi`` (default, the seed's choice): the Voronoi cells of the strip, rectangles
-  [x_L - h/2, x_L + h/2] x [0, H/2] (or [H/2, H]), with the same one-point-per-side
-  divergence rule as ``rkfx.quadrature.smoothed_gradients``;
+  [x_L - h/2, x_L + h/2] x [0, H/2] (or [H/2, H]), from ``rkfx.grid_cells.grid_domains``:
+  each cell cut through its node into quadrants, one smoothing point per quadrant side
+  (so a cell's top and bottom sides carry two points each), smoothed by
+  ``rkfx.quadrature.smoothed_gradients``;
 * ``median-dual``: rkfx's own cells (``rkfx.nodal_domains``). On a strip with diagonal-split
   quads they are not mirror-symmetric: of the four particles around x = L/2, the two on the
   diagonal of the middle quad own 2/3 of it. All four must fail for the bar to break (they
@@ -54,10 +56,11 @@ the unregularized fine models, which snap back ((L - L_s) / E < L_s (kappa_c - k
 n >= 32): their curves turn back to F = 0 at u_T = L_s kappa_c < u_peak, so the energy they
 dissipate is the damage energy of the band, with no dynamic loss.
 
-The regularized SCNI models break at u_T^max = 0.99948 w_c at every n: the 2-D RK field of the
-opening band has a small shear, gamma_xy / eps_xx ~ 4.5% in the band particles, which raises
-Mazars' eps_eq over eps_xx by 5.0e-4, so kappa_c is reached that much earlier (the seed's 1-D
-bar has no shear; it reports 1.8858e-2 against 1.8850e-2).
+The regularized SCNI models break at u_T^max = 0.99994 w_c at every n: the 2-D RK field of the
+opening band has a small shear, gamma_xy / eps_xx ~ 1.6% in the band particles, which raises
+Mazars' eps_eq over eps_xx by 6.4e-5, so kappa_c is reached that much earlier (the seed's 1-D
+bar has no shear; it reports 1.8858e-2 against 1.8850e-2). With one smoothing point per whole
+cell side instead of per quadrant side the shear is ~4.5% and u_T^max = 0.99948 w_c.
 
 Reported per model and n: the force-displacement curve and u_T^max
 (``rkfx.damage.failure_displacement``: the softening branch extrapolated to F = 0; a summary
@@ -69,7 +72,7 @@ work balance int F du - W_elastic as a check), the damage along the bar at u_T =
 across per background cell, direct gradients of u^h, damage at the Gauss points with a
 crack-band kappa_c = w_c / h in the middle cell) and (b) SCNI: the largest relative deviation
 from the mean stress. SCNI gives a constant stress to round-off while the bar is elastic (the
-patch test); once the band softens it carries an odd-even ripple of ~0.2% (Gauss: ~16%): the
+patch test); once the band softens it carries an odd-even ripple of ~0.03% (Gauss: ~16%): the
 RK field cannot bend sharply at the band, and equilibrium leaves the stress differences one
 null-space mode of the map from coefficients to cell-side values. FEM: crack-band linear
 triangles (``fem_baselines.crack_band``) with n - 1 elements along the bar.
@@ -94,12 +97,13 @@ import scipy.sparse.linalg as spla
 from .. import damage as dm
 from ..boundary import Dirichlet, transformation_constraints
 from ..errors import InputError, SolverError
+from ..grid_cells import grid_domains
 from ..nodal_domains import nodal_domains
 from ..operators import block_diagonal, strain_matrix
 from ..particles import Particles, structured
 from ..quadrature import smoothed_gradients
 from ..shape_functions import RKApproximation, evaluate, rk_approximation
-from ..sparse_rows import SparseRows, combine_rows
+from ..sparse_rows import SparseRows
 from . import _cli
 from ._cli import Param, Results, Run
 
@@ -160,55 +164,24 @@ class Strip:
     thickness: float
 
 
-def _voronoi_rows(p: Particles, rk: RKApproximation, xs: np.ndarray, ys: np.ndarray):
-    """Smoothed gradients (4.33) on the Voronoi cells of a tensor grid (rectangles), one
-    midpoint per side as in ``rkfx.quadrature.smoothed_gradients``; their quadrants as
-    ``CellGeometry`` and their areas and x-ranges."""
-    xm = np.r_[xs[0], 0.5 * (xs[1:] + xs[:-1]), xs[-1]]
-    ym = np.r_[ys[0], 0.5 * (ys[1:] + ys[:-1]), ys[-1]]
-    ix, iy = np.meshgrid(np.arange(len(xs)), np.arange(len(ys)))
-    ix, iy = ix.ravel(), iy.ravel()  # the node order of rkfx.particles.graded
-    xl, xr, yb, yt = xm[ix], xm[ix + 1], ym[iy], ym[iy + 1]
-    area = (xr - xl) * (yt - yb)
-    xc, yc, zero = 0.5 * (xl + xr), 0.5 * (yb + yt), np.zeros_like(xl)
-    pts = np.stack([np.c_[xl, yc], np.c_[xr, yc], np.c_[xc, yb], np.c_[xc, yt]], axis=1).reshape(-1, 2)
-    nl = np.stack([np.c_[yb - yt, zero], np.c_[yt - yb, zero], np.c_[zero, xl - xr], np.c_[zero, xr - xl]],
-                  axis=1).reshape(-1, 2)
-    m = len(area)
-    grad = combine_rows(evaluate(rk, pts), np.arange(0, 4 * m + 1, 4), np.arange(4 * m),
-                        nl / np.repeat(area, 4)[:, None])
-    quads, owner = [], []
-    for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1)):
-        X, Y = (xr if sx > 0 else xl), (yt if sy > 0 else yb)
-        q = np.stack([p.x, np.c_[X, p.x[:, 1]], np.c_[X, Y], np.c_[p.x[:, 0], Y]], axis=1)
-        if sx * sy < 0:
-            q = q[:, [0, 3, 2, 1]]  # counter-clockwise
-        keep = (X != p.x[:, 0]) & (Y != p.x[:, 1])
-        quads.append(q[keep])
-        owner.append(np.flatnonzero(keep))
-    geometry = dm.CellGeometry(np.concatenate(owner), np.concatenate(quads), m)
-    return grad, area, geometry, np.c_[xl, xr]
-
-
 def strip(L: float, A: float, n: int, cells: str = "voronoi", support_factor: float = 1.5) -> Strip:
     """The SCNI discretization of the bar with ``n`` nodes along the axis."""
     h = L / (n - 1)
     p = structured(L, h, n, 2)
     rk = rk_approximation(p.x, p.spacing, support_factor)
     if cells == "voronoi":
-        grad, volume, geometry, extent = _voronoi_rows(p, rk, np.linspace(0.0, L, n), np.array([0.0, h]))
+        domains = grid_domains(np.linspace(0.0, L, n), np.array([0.0, h]))  # the node order of structured
+        geometry = dm.cell_geometry(domains)
     elif cells == "median-dual":
         domains = nodal_domains(p)
-        grad = smoothed_gradients(p, rk, domains, subcells=False).cell
-        volume = domains.area
         geometry = dm.cell_geometry(p)
-        lo, hi = np.full(p.num_nodes, np.inf), np.full(p.num_nodes, -np.inf)
-        np.minimum.at(lo, geometry.node, geometry.vertices[:, :, 0].min(axis=1))
-        np.maximum.at(hi, geometry.node, geometry.vertices[:, :, 0].max(axis=1))
-        extent = np.c_[lo, hi]
     else:
         raise InputError(f"unknown cells {cells!r}; choose from {', '.join(CELLS)}")
-    return _with_constraints(p, rk, strain_matrix(grad).tocsr(), p.x, volume, extent, geometry, h, A)
+    grad = smoothed_gradients(p, rk, domains, subcells=False).cell
+    lo, hi = np.full(p.num_nodes, np.inf), np.full(p.num_nodes, -np.inf)
+    np.minimum.at(lo, geometry.node, geometry.vertices[:, :, 0].min(axis=1))
+    np.maximum.at(hi, geometry.node, geometry.vertices[:, :, 0].max(axis=1))
+    return _with_constraints(p, rk, strain_matrix(grad).tocsr(), p.x, domains.area, np.c_[lo, hi], geometry, h, A)
 
 
 def gauss_strip(L: float, A: float, n: int, support_factor: float = 1.5) -> Strip:
@@ -258,7 +231,7 @@ class _Trial:
 
 
 @dataclass
-class Path:
+class LoadPath:
     """The load path of one model.
 
     Attributes:
@@ -341,7 +314,7 @@ class _NewtonMatrix:
 
 
 def load_path(s: Strip, model: dm.DamageModel, targets: np.ndarray, snapshots: Sequence[float] = (),
-              energy_step: float | None = None, rtol: float = 1e-10, max_iterations: int = 25) -> Path:
+              energy_step: float | None = None, rtol: float = 1e-10, max_iterations: int = 25) -> LoadPath:
     """Quasi-static path through the tip displacements ``targets`` (and ``snapshots``).
 
     Newton's method on the equilibrium f_int(d) = G^T mu with the collocation constraints
@@ -422,7 +395,7 @@ def load_path(s: Strip, model: dm.DamageModel, targets: np.ndarray, snapshots: S
     count = dm.march(all_targets, lambda u: newton(u, None), accept, arc=lambda t: newton(None, t),
                      energy_step=tau)
     arrays = {key: np.array(val) for key, val in hist.items()}
-    return Path(**arrays, snapshots=snaps, state=cur["state"], coefficients=cur["d"], multipliers=cur["mu"],
+    return LoadPath(**arrays, snapshots=snaps, state=cur["state"], coefficients=cur["d"], multipliers=cur["mu"],
                 iterations=cur["its"], cuts=count["cuts"], arc_steps=count["arc_steps"],
                 wall_time_s=time.perf_counter() - t0)
 

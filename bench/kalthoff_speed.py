@@ -1,0 +1,82 @@
+"""Benchmark: wall time of Kalthoff's impact problem by the damage particle method through 80 µs.
+
+The regularized model of ``rkfx.cases.kalthoff`` with tracking on at ``--nodes`` particles per
+side (450: 450 x 451 = 202,950 particles, h = 0.1 / 449 m, the seed's finest model has
+202,500). Reported: the set-up (grid, RK rows with the crack, cells, B~), the time stepping
+(central differences with the damage update of every particle, tracking, projections and
+energy bookkeeping; JIT compilation excluded by a warm-up run), steps and time per step, and
+the split of one step between the two sparse products (B~ d and B~^T Sigma V), the damage
+kernels and the rest, measured on the final state.
+
+Usage: python bench/kalthoff_speed.py [--nodes 450] [--t-end 8e-5]
+The last line reads ``<N> particles: <seconds> s for <T> us``.
+"""
+import argparse
+import time
+
+import numpy as np
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--nodes", type=int, default=450, help="particles per side")
+    ap.add_argument("--t-end", type=float, default=80e-6, help="end time [s]")
+    args = ap.parse_args(argv)
+
+    from rkfx import damage as dm
+    from rkfx.cases import _dynamic_fracture as dyn
+    from rkfx.cases import kalthoff as k
+    from rkfx.crack_tracking import tracking
+    from rkfx.explicit_damage import DamageForce, damage_field
+    from rkfx.warmup import warm_up
+
+    warm_up()
+    k.run(methods=("rkpm",), nodes=[40], unregularized_nodes=[], no_tracking_nodes=[], fem_nodes=[],
+          t_end=5e-6)  # compile the step kernels
+    material = dm.DamageMaterial(1.9e11, 0.3, 9.5e8, 2e4, "strain")
+    t0 = time.perf_counter()
+    xs, ys = k.grid(args.nodes)
+    pl = dyn.plate(xs, ys, [((0.0, k.A2), (k.A1, k.A2))], [(False, True)], material, 8000.0, 1.75)
+    seeds = np.linalg.norm(pl.p.x - [k.A1, k.A2], axis=1) < 0.75 * pl.h
+    track = tracking(pl.p.x, pl.p.spacing, 0.3, seeds, 3.5)
+    model = dyn.damage_model(pl, material)
+    conditions = k.model_conditions(pl, 16.5)
+    setup = time.perf_counter() - t0
+    run = dyn.simulate("bench", pl, model, track, conditions, args.t_end)
+    n = pl.p.num_nodes
+    # Split of one step, on the final damage state.
+    field = damage_field(model, track, pl.dt)
+    for name, arr in field.arrays.items():
+        if name in ("damage", "kappa", "normal"):
+            arr[...] = getattr(run, name)
+    field.damaged[:] = run.damage > 0
+    field.allowed[:] = True
+    force = DamageForce(pl.op, model, field, track, pl.dt)
+    d = np.random.default_rng(0).standard_normal(2 * n) * 1e-9
+    reps = 20
+    t = time.perf_counter()
+    for _ in range(reps):
+        e = pl.op.strain(d)
+    t_strain = (time.perf_counter() - t) / reps
+    t = time.perf_counter()
+    for _ in range(reps):
+        pl.op.force(e)
+    t_force = (time.perf_counter() - t) / reps
+    t = time.perf_counter()
+    for _ in range(reps):
+        force(d)
+    t_all = (time.perf_counter() - t) / reps
+    per_step = run.wall_time_s / run.steps
+    print(f"particles {n:,} (grid {len(xs)} x {len(ys)}), nnz(grad N) {pl.op.rows.indices.size:,}, "
+          f"h = {1e6 * pl.h:.1f} um, dt = {1e9 * pl.dt:.2f} ns")
+    print(f"set-up {setup:.1f} s; {run.steps} steps in {run.wall_time_s:.1f} s = {1e3 * per_step:.1f} ms per step")
+    print(f"one step: B~ d {1e3 * t_strain:.1f} ms, B~^T Sigma V {1e3 * t_force:.1f} ms, damage force in all "
+          f"{1e3 * t_all:.1f} ms (kernels and tracking {1e3 * (t_all - t_strain - t_force):.1f} ms), "
+          f"rest of the step {1e3 * (per_step - t_all):.1f} ms")
+    print(f"dissipated {run.history[-1, 1]:.0f} J/m, failed particles {int((run.damage >= 0.9).sum())}, "
+          f"energy balance error {run.energy_error:.1e}")
+    print(f"{n} particles: {run.wall_time_s + setup:.1f} s for {1e6 * args.t_end:.0f} us")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,470 @@
+"""Explicit-dynamics crack-band finite elements for Kalthoff's impact problem (seed 4.3.2).
+
+The problem (Kalthoff and Winkler's edge-cracked plate, upper half by symmetry; plane strain):
+
+    domain        [0, side] x [0, side] (0.1 m x 0.1 m)
+    slit          y = a2 (0.025 m) for 0 <= x <= a1 (0.05 m): two traction-free faces
+    symmetry      y = 0: u_y = 0
+    impact        x = 0, 0 <= y < a2 (the edge below the slit, including the slit's lower
+                  face end at y = a2^-): u_x velocity v0 (16.5 m/s) from t = 0, u_y free
+    elsewhere     traction free
+
+Mesh. gmsh (OpenCASCADE kernel, headless) meshes the square with the slit line embedded
+(``fragment``) at a uniform target size h; gmsh's ``Crack`` plugin then duplicates the nodes
+of the slit (both ends stay single except the mouth at x = 0, which lies on the outer
+boundary and is opened through ``OpenBoundaryPhysicalGroup``), so the two faces share only
+the tip node (a1, a2). ``dolfinx.io.gmsh.model_to_mesh`` converts the model.
+
+Discretisation. Linear triangles (vector P1): constant strain per cell. dolfinx assembles
+
+    * the lumped mass, M_i = rho int N_i dx per component (row sums of the consistent
+      mass), interleaved per node like ``rkfx.explicit`` expects;
+    * the strain operator B (rows (eps_xx, eps_yy, gamma_xy) of each cell, columns the
+      interleaved nodal displacements) from the mixed form int eps(u) : tau dx with tau
+      in a DG0 (3,) space, divided by the cell areas; it is kept as scipy CSR with B^T.
+
+Material (``rkfx.damage``): sigma = (1 - D) C eps, C plane strain; Mazars' equivalent strain
+(4.6) of the cell strain; history kappa = max(kappa_old, eps_eq) (4.3)-(4.5); linear
+softening D(kappa) (4.2) between kappa0 = f_t / E and kappa_c. Crack-band scaling (Bazant
+and Oh 1983): kappa_c = (G_F / f_t) / h_e with h_e the chord of the triangle through its
+centroid perpendicular to the crack normal n, so that a band of completely failed cells
+dissipates G_F per unit crack length (f_t kappa_c / 2 per unit volume times the band area
+h_e x length). n is fixed when the cell's damage initiates (kappa first reaches kappa0), along
+the major principal direction of the effective stress C eps. Any cell may damage: there is
+no crack tracking. ``regularized=False`` uses one given kappa_c for every cell instead (the
+mesh-dependent, unregularized comparison).
+
+Time integration: central differences with the lumped mass (``rkfx.explicit.run_explicit``),
+essential conditions as rows of the identity (``Constraint``): u_y = 0 on y = 0 and the
+impact velocity on the impact edge. The internal-force callable updates the damage history
+in place (it is called once per step with the new displacement); the history arrays are the
+run's ``extra_state``, so checkpoints and ``resume`` restore them. The dissipated energy is
+accumulated per step from the exact dissipation density (``dissipation_density``) of the
+cells whose history grew, and is part of the extra state too.
+
+Stable step: dt = courant * min_e(a_e) / c_d with a_e the smallest altitude of cell e and
+c_d = sqrt((lambda + 2 mu) / rho).
+
+Parallelism: the mesh and the time loop live on one process. With a communicator of several
+ranks, rank 0 computes (on ``MPI.COMM_SELF``) and the result is broadcast to every rank.
+
+Units: SI (m, s, kg, Pa, N/m); energies are per unit thickness [J/m].
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import dolfinx_solver  # noqa: F401  (must precede dolfinx / petsc4py: orders MPI loading)
+
+import gmsh
+import numpy as np
+import scipy.sparse as sp
+from mpi4py import MPI
+
+import dolfinx
+import dolfinx.fem
+import dolfinx.fem.petsc
+import dolfinx.io.gmsh
+import dolfinx.mesh
+import ufl
+
+from rkfx import damage as dm
+from rkfx.errors import InputError
+from rkfx.explicit import Constraint
+from rkfx.explicit_damage import DamageRun, run_damage
+
+__all__ = [
+    "CellStrain",
+    "CrackedPlateMesh",
+    "DynamicCrackBandResult",
+    "FemOperators",
+    "cracked_plate_mesh",
+    "fem_operators",
+    "kalthoff_crack_band",
+    "slit_sides",
+    "stable_time_step",
+    "triangle_geometry",
+]
+
+
+
+# --------------------------------------------------------------------------- geometry
+
+
+def triangle_geometry(vertices: np.ndarray) -> dm.CellGeometry:
+    """Each triangle as three convex quadrilaterals about its centroid g, (g, m_ca, a, m_ab)
+    and so on (counter-clockwise), so that ``rkfx.damage.chord_lengths`` gives the exact chord
+    of the triangle through its centroid.
+
+    Args:
+        vertices: Triangle vertices, shape ``(m, 3, 2)`` [m] (either orientation).
+    """
+    v = np.asarray(vertices, float).reshape(-1, 3, 2).copy()
+    e1, e2 = v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]
+    flip = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0] < 0
+    v[flip] = v[flip][:, ::-1]
+    g = np.broadcast_to(v.mean(axis=1, keepdims=True), v.shape)
+    nxt, prv = np.roll(v, -1, axis=1), np.roll(v, 1, axis=1)
+    quads = np.stack([g, 0.5 * (prv + v), v, 0.5 * (v + nxt)], axis=2)   # (m, 3, 4, 2)
+    return dm.CellGeometry(np.repeat(np.arange(len(v)), 3), quads.reshape(-1, 4, 2), len(v))
+
+
+def _altitudes(vertices: np.ndarray) -> np.ndarray:
+    """Smallest altitude 2 A / (longest side) of each triangle, shape ``(m,)`` [m]."""
+    e = np.roll(vertices, -1, axis=1) - vertices
+    area = 0.5 * np.abs(e[:, 0, 0] * e[:, 1, 1] - e[:, 0, 1] * e[:, 1, 0])
+    return 2.0 * area / np.linalg.norm(e, axis=2).max(axis=1)
+
+
+@dataclass
+class CrackedPlateMesh:
+    """The slit plate as a dolfinx mesh with its vector P1 space.
+
+    Attributes:
+        mesh: dolfinx mesh (triangles) on ``MPI.COMM_SELF``.
+        V: Vector P1 space; node i carries unknowns 2 i (u_x) and 2 i + 1 (u_y).
+        x: Node coordinates, shape ``(n, 2)`` [m].
+        triangles: Node indices of each cell, shape ``(m, 3)``.
+        h: Target element size [m].
+    """
+
+    mesh: dolfinx.mesh.Mesh
+    V: dolfinx.fem.FunctionSpace
+    x: np.ndarray
+    triangles: np.ndarray
+    h: float
+
+    @property
+    def num_nodes(self) -> int:
+        return len(self.x)
+
+    @property
+    def num_cells(self) -> int:
+        return len(self.triangles)
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """Cell vertices, shape ``(m, 3, 2)`` [m]."""
+        return self.x[self.triangles]
+
+    @property
+    def centroids(self) -> np.ndarray:
+        """Cell centroids, shape ``(m, 2)`` [m]."""
+        return self.vertices.mean(axis=1)
+
+
+def _check_geometry(h: float, side: float, a1: float, a2: float) -> None:
+    for name, val in (("side", side), ("a1", a1), ("a2", a2)):
+        if not (np.isfinite(val) and val > 0):
+            raise InputError(f"{name} = {val!r} must be positive and finite (lengths in m)")
+    if not (a1 < side and a2 < side):
+        raise InputError(f"slit end (a1, a2) = ({a1:g}, {a2:g}) must lie inside the plate of side {side:g}")
+    if not (np.isfinite(h) and h > 0):
+        raise InputError(f"element size h = {h!r} must be positive and finite (e.g. h=1e-3 m)")
+    coarse = 0.5 * min(a1, a2, side - a1, side - a2)
+    if h > coarse:
+        raise InputError(f"element size h = {h:g} m is too coarse for the slit geometry; "
+                         f"use h <= {coarse:g} m (two elements across its shortest distance to an edge)")
+
+
+def cracked_plate_mesh(h: float, *, side: float = 0.1, a1: float = 0.05, a2: float = 0.025) -> CrackedPlateMesh:
+    """Mesh [0, side]^2 with a slit along y = a2, 0 <= x <= a1, whose faces share only the tip.
+
+    Args:
+        h: Uniform target element size [m].
+        side: Plate side [m].
+        a1: Slit length from x = 0 (x of the tip) [m].
+        a2: Height of the slit [m].
+    """
+    _check_geometry(h, side, a1, a2)
+    started = gmsh.isInitialized()
+    if not started:
+        gmsh.initialize(interruptible=False)
+    gmsh.option.setNumber("General.Terminal", 0)
+    try:
+        gmsh.model.add("kalthoff_slit")
+        try:
+            occ = gmsh.model.occ
+            square = occ.addRectangle(0.0, 0.0, 0.0, side, side)
+            slit = occ.addLine(occ.addPoint(0.0, a2, 0.0), occ.addPoint(a1, a2, 0.0))
+            occ.fragment([(2, square)], [(1, slit)])
+            occ.synchronize()
+            tol = 1e-4 * side   # OpenCASCADE pads bounding boxes
+            curves = [t for _, t in gmsh.model.getEntities(1)
+                      if _box_on_slit(gmsh.model.getBoundingBox(1, t), a1, a2, tol)]
+            mouth = [t for _, t in gmsh.model.getEntities(0)
+                     if np.allclose(gmsh.model.getValue(0, t, []), [0.0, a2, 0.0], atol=tol)]
+            if len(curves) != 1 or len(mouth) != 1:
+                raise RuntimeError(f"gmsh did not embed the slit (curves {curves}, mouth {mouth})")
+            gmsh.model.addPhysicalGroup(2, [t for _, t in gmsh.model.getEntities(2)], 1, name="plate")
+            gmsh.model.addPhysicalGroup(1, curves, 2, name="slit")
+            gmsh.model.addPhysicalGroup(0, mouth, 3, name="mouth")
+            gmsh.option.setNumber("Mesh.MeshSizeMin", h)
+            gmsh.option.setNumber("Mesh.MeshSizeMax", h)
+            gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+            gmsh.model.mesh.generate(2)
+            gmsh.plugin.setNumber("Crack", "Dimension", 1)
+            gmsh.plugin.setNumber("Crack", "PhysicalGroup", 2)
+            gmsh.plugin.setNumber("Crack", "OpenBoundaryPhysicalGroup", 3)
+            gmsh.plugin.run("Crack")
+            gmsh.model.mesh.renumberNodes()   # dolfinx wants contiguous node tags
+            md = dolfinx.io.gmsh.model_to_mesh(gmsh.model, MPI.COMM_SELF, 0, gdim=2)
+        finally:
+            gmsh.model.remove()
+    finally:
+        if not started:
+            gmsh.finalize()
+    mesh = md.mesh
+    V = dolfinx.fem.functionspace(mesh, ("Lagrange", 1, (2,)))
+    x = V.tabulate_dof_coordinates()[:, :2].copy()
+    tri = np.asarray(V.dofmap.list, np.int64).copy()
+    return CrackedPlateMesh(mesh, V, x, tri, float(h))
+
+
+def _box_on_slit(box, a1: float, a2: float, tol: float) -> bool:
+    x0, y0, _, x1, y1, _ = box
+    return abs(y0 - a2) < tol and abs(y1 - a2) < tol and x0 < tol and abs(x1 - a1) < tol
+
+
+def slit_sides(m: CrackedPlateMesh, a1: float, a2: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Nodes on the slit line y = a2, x < a1 of the upper face, of the lower face, and the tip.
+
+    A node belongs to the upper (lower) face if all its cells lie above (below) the slit.
+
+    Returns:
+        ``(upper, lower, tip)`` node indices.
+    """
+    tol = 1e-9 * max(1.0, a1)
+    on = np.flatnonzero(np.isclose(m.x[:, 1], a2, atol=tol) & (m.x[:, 0] < a1 - tol))
+    cy = m.centroids[:, 1]
+    above = np.zeros(m.num_nodes, bool)
+    below = np.zeros(m.num_nodes, bool)
+    np.logical_or.at(above, m.triangles.ravel(), np.repeat(cy > a2, 3))
+    np.logical_or.at(below, m.triangles.ravel(), np.repeat(cy < a2, 3))
+    tip = np.flatnonzero(np.hypot(m.x[:, 0] - a1, m.x[:, 1] - a2) < tol)
+    return on[above[on] & ~below[on]], on[below[on] & ~above[on]], tip
+
+
+# --------------------------------------------------------------------------- operators
+
+
+@dataclass
+class FemOperators:
+    """Assembled P1 operators on a mesh.
+
+    Attributes:
+        mass: Lumped mass per interleaved unknown, shape ``(2 n,)`` [kg/m].
+        B: Cell strains (eps_xx, eps_yy, gamma_xy) of cell c in rows 3 c .. 3 c + 2 from the
+            interleaved nodal displacements, scipy CSR ``(3 m, 2 n)`` [1/m].
+        BT: B^T as CSR.
+        area: Cell areas, shape ``(m,)`` [m^2].
+    """
+
+    mass: np.ndarray
+    B: sp.csr_matrix
+    BT: sp.csr_matrix
+    area: np.ndarray
+
+
+def fem_operators(m: CrackedPlateMesh, rho: float) -> FemOperators:
+    """Assemble the lumped mass and the cell strain operator with dolfinx (see module doc)."""
+    mesh, V = m.mesh, m.V
+    v = ufl.TestFunction(V)
+    ones = ufl.as_vector((1.0, 1.0))
+    mass = dolfinx.fem.assemble_vector(dolfinx.fem.form(rho * ufl.inner(ones, v) * ufl.dx)).array.copy()
+
+    Q = dolfinx.fem.functionspace(mesh, ("DG", 0, (3,)))
+    u, tau = ufl.TrialFunction(V), ufl.TestFunction(Q)
+    g = ufl.grad(u)
+    voigt = ufl.as_vector((g[0, 0], g[1, 1], g[0, 1] + g[1, 0]))
+    # PETSc storage: dolfinx's own CSR matrix refuses the non-square (3, 2) blocks
+    pmat = dolfinx.fem.petsc.assemble_matrix(dolfinx.fem.form(ufl.inner(voigt, tau) * ufl.dx))
+    pmat.assemble()
+    indptr, indices, values = pmat.getValuesCSR()
+    mat = sp.csr_matrix((values, indices, indptr), shape=pmat.getSize())
+    pmat.destroy()
+
+    Q0 = dolfinx.fem.functionspace(mesh, ("DG", 0))
+    q = ufl.TestFunction(Q0)
+    area_dof = dolfinx.fem.assemble_vector(dolfinx.fem.form(q * ufl.dx)).array.copy()
+    num_cells = m.num_cells
+    cell_dof = np.asarray(Q.dofmap.list, np.int64)[:num_cells, 0]
+    area = area_dof[np.asarray(Q0.dofmap.list, np.int64)[:num_cells, 0]]
+    rows = (3 * cell_dof[:, None] + np.arange(3)).ravel()
+    B = sp.csr_matrix(mat[rows])
+    B = sp.csr_matrix(sp.diags(np.repeat(1.0 / area, 3)) @ B)
+    B.eliminate_zeros()
+    B.sort_indices()
+    return FemOperators(mass, B, B.T.tocsr(), area)
+
+
+def stable_time_step(m: CrackedPlateMesh, E: float, nu: float, rho: float, courant: float = 0.5) -> float:
+    """dt = courant * (smallest altitude of any cell) / c_d [s], c_d = sqrt((lambda + 2 mu) / rho)."""
+    if not 0 < courant <= 1:
+        raise InputError(f"courant = {courant!r} must lie in (0, 1]; 0.5 is the default")
+    lam = E * nu / ((1 + nu) * (1 - 2 * nu))
+    mu = E / (2 * (1 + nu))
+    c_d = np.sqrt((lam + 2 * mu) / rho)
+    return float(courant * _altitudes(m.vertices).min() / c_d)
+
+
+# --------------------------------------------------------------------------- damage force
+
+
+
+@dataclass(frozen=True)
+class CellStrain:
+    """The cell strains of linear triangles as the strain operator of ``rkfx.explicit_damage``:
+    damage points are the cells, ``strain`` = B d, ``force`` = B^T (sigma area)."""
+
+    ops: FemOperators
+
+    @property
+    def num_nodes(self) -> int:
+        return len(self.ops.area)
+
+    def strain(self, d: np.ndarray) -> np.ndarray:
+        return (self.ops.B @ d).reshape(-1, 3)
+
+    def force(self, stress: np.ndarray) -> np.ndarray:
+        return self.ops.BT @ (stress * self.ops.area[:, None]).ravel()
+
+
+# --------------------------------------------------------------------------- driver
+
+
+@dataclass
+class DynamicCrackBandResult:
+    """A crack-band run of Kalthoff's problem.
+
+    Attributes:
+        num_nodes, num_cells: Mesh size (slit nodes counted twice).
+        h: Target element size [m].
+        run: The explicit damage run (history, final damage per cell, steps, dt, wall time).
+        centroids: Cell centroids, shape ``(m, 2)`` [m].
+        x: Node coordinates, shape ``(n, 2)`` [m].
+        triangles: Node indices per cell, shape ``(m, 3)`` (for matplotlib ``tripcolor``).
+        wall_time_s: Wall time of the whole call (mesh, assembly, time loop) [s].
+    """
+
+    num_nodes: int
+    num_cells: int
+    h: float
+    run: DamageRun
+    centroids: np.ndarray
+    x: np.ndarray
+    triangles: np.ndarray
+    wall_time_s: float
+
+    @property
+    def time(self) -> np.ndarray:
+        """Sample times [s]."""
+        return self.run.column("time")
+
+    @property
+    def dissipated(self) -> np.ndarray:
+        """Dissipated energy at the sample times [J/m]."""
+        return self.run.column("dissipated")
+
+    @property
+    def damage(self) -> np.ndarray:
+        """Final damage per cell, shape ``(m,)``."""
+        return self.run.damage
+
+
+def _identity_rows(dofs: np.ndarray, n2: int) -> sp.csr_matrix:
+    k = len(dofs)
+    return sp.csr_matrix((np.ones(k), (np.arange(k), dofs)), shape=(k, n2))
+
+
+def kalthoff_crack_band(h: float, t_end: float = 80e-6, *, E: float = 1.9e11, nu: float = 0.3,
+                        rho: float = 8000.0, ft: float = 9.5e8, GF: float = 2e4, v0: float = 16.5,
+                        side: float = 0.1, a1: float = 0.05, a2: float = 0.025, regularized: bool = True,
+                        kappa_c: float | None = None, courant: float = 0.5, samples: int = 200,
+                        label: str | None = None, checkpoint_every: int = 0, work_dir: str | Path | None = None,
+                        resume: str | Path | None = None, comm: MPI.Comm = MPI.COMM_SELF
+                        ) -> DynamicCrackBandResult:
+    """Run Kalthoff's impact problem with explicit crack-band finite elements (module doc).
+
+    Args:
+        h: Uniform target element size [m].
+        t_end: Final time [s] (rounded up to whole steps).
+        E, nu, rho: Young's modulus [Pa], Poisson's ratio [-], density [kg/m^3].
+        ft, GF: Tensile strength [Pa] and fracture energy [N/m].
+        v0: Impact velocity [m/s].
+        side, a1, a2: Plate side, slit length and slit height [m].
+        regularized: Crack-band kappa_c = 2 G_F / (f_t h_e) per cell; if ``False`` every cell
+            uses the given ``kappa_c``.
+        kappa_c: Critical strain of the unregularized model [-] (only with ``regularized=False``).
+        courant: Fraction of the stable step (0, 1].
+        samples: History samples over the run.
+        label, checkpoint_every, work_dir, resume: As for ``rkfx.explicit_damage.run_damage``
+            (default label ``fem-crack-band h=<h>``).
+        comm: Communicator; rank 0 computes and broadcasts the result.
+
+    Returns:
+        The run's result on every rank of ``comm``.
+    """
+    if comm.size > 1:
+        result, error = None, None
+        if comm.rank == 0:
+            try:
+                result = kalthoff_crack_band(
+                    h, t_end, E=E, nu=nu, rho=rho, ft=ft, GF=GF, v0=v0, side=side, a1=a1, a2=a2,
+                    regularized=regularized, kappa_c=kappa_c, courant=courant, samples=samples, label=label,
+                    checkpoint_every=checkpoint_every, work_dir=work_dir, resume=resume)
+            except Exception as exc:  # re-raised on every rank
+                error = exc
+        result, error = comm.bcast((result, error), root=0)
+        if error is not None:
+            raise error
+        return result
+
+    wall = time.perf_counter()
+    material = dm.DamageMaterial(E=E, nu=nu, ft=ft, GF=GF, plane="strain")
+    if not (np.isfinite(rho) and rho > 0):
+        raise InputError(f"density rho = {rho!r} must be positive (kg/m^3, e.g. rho=8000)")
+    if not (np.isfinite(t_end) and t_end > 0):
+        raise InputError(f"t_end = {t_end!r} must be positive (seconds, e.g. t_end=80e-6)")
+    if not np.isfinite(v0):
+        raise InputError(f"impact velocity v0 = {v0!r} must be finite (m/s, e.g. v0=16.5)")
+    if int(samples) != samples or samples < 1:
+        raise InputError(f"samples = {samples!r} must be a positive integer")
+    if regularized:
+        if kappa_c is not None:
+            raise InputError("kappa_c is only used with regularized=False; drop it or set regularized=False")
+    else:
+        if kappa_c is None or not (np.isfinite(kappa_c) and kappa_c > material.kappa0):
+            raise InputError(f"regularized=False needs kappa_c > kappa0 = f_t / E = {material.kappa0:.4g}; "
+                             f"got kappa_c = {kappa_c!r}")
+    _check_geometry(h, side, a1, a2)
+    h_max = 2.0 * E * GF / ft**2
+    m = cracked_plate_mesh(h, side=side, a1=a1, a2=a2)
+    if regularized:
+        # the band width area / chord stays below the longest side
+        longest = np.linalg.norm(np.roll(m.vertices, -1, axis=1) - m.vertices, axis=2).max()
+        if longest >= h_max:
+            raise InputError(f"band too wide: elements up to {longest:.3g} m long may have h_e > 2 E G_F / f_t^2 "
+                             f"= {h_max:.3g} m, where kappa_c <= kappa0 (snap-back); use h < {h_max / 1.5:.3g} m")
+    ops = fem_operators(m, rho)
+    dt = stable_time_step(m, E, nu, rho, courant)
+    n2 = 2 * m.num_nodes
+    model = dm.damage_model(material, ops.area, geometry=triangle_geometry(m.vertices) if regularized else None,
+                            kappa_c=kappa_c, regularized=regularized, band_factor=2.0)
+    tol = 1e-9 * side
+    bottom = np.flatnonzero(np.abs(m.x[:, 1]) < tol)
+    _, lower, _ = slit_sides(m, a1, a2)
+    left = np.abs(m.x[:, 0]) < tol
+    impact = np.flatnonzero(left & (m.x[:, 1] < a2 - tol))
+    impact = np.union1d(impact, lower[np.abs(m.x[lower, 0]) < tol])   # the slit's lower face end
+    v_impact = np.full(len(impact), float(v0))
+    constraints = [Constraint(_identity_rows(2 * bottom + 1, n2)),
+                   Constraint(_identity_rows(2 * impact, n2), velocity=lambda t: v_impact)]
+    run = run_damage(label or f"fem-crack-band h={h:g}", CellStrain(ops), ops.mass, dt, model, None, constraints,
+                     t_end, samples=samples, checkpoint_every=checkpoint_every,
+                     work_dir=None if work_dir is None else Path(work_dir),
+                     resume=None if resume is None else Path(resume))
+    return DynamicCrackBandResult(m.num_nodes, m.num_cells, float(h), run, m.centroids, m.x, m.triangles,
+                                  time.perf_counter() - wall)

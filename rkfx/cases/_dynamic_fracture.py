@@ -1,0 +1,160 @@
+"""What the dynamic fracture cases share: the particle plate, the run with checkpoints, crack metrics.
+
+A plate is a tensor grid of particles whose rectangular Voronoi cells (``rkfx.grid_cells``)
+have faces along the pre-existing cracks, so no cell straddles a crack; the RK shape
+functions see the cracks by diffraction (``rkfx.cracks``). The damage particle method
+(``rkfx.explicit_damage``) runs in ``rkfx.explicit``'s central-difference driver.
+
+``simulate`` runs a model on a plate through ``rkfx.explicit_damage.run_damage``, which
+keeps finished work (checkpoints, finished results read back on resume).
+"""
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .. import damage as dm
+from ..crack_tracking import Tracking
+from ..cracks import Cracks, cracks
+from ..elasticity import ElasticMaterial
+from ..explicit import (
+    Constraint,
+    SmearedStrain,
+    lumped_mass,
+    smeared_strain,
+    stable_time_step,
+)
+from ..explicit_damage import DamageRun, run_damage
+from ..grid_cells import grid_domains
+from ..nodal_domains import NodalDomains
+from ..particles import Particles, graded
+from ..shape_functions import RKApproximation, rk_approximation
+
+
+@dataclass(frozen=True)
+class Plate:
+    """A particle plate on a tensor grid with pre-existing cracks along cell faces.
+
+    Attributes:
+        xs, ys: Grid coordinates [m].
+        p: Particles (node j * nx + i at (xs[i], ys[j])).
+        rk: RK approximation with the cracks.
+        domains: Rectangular Voronoi cells.
+        op: Smeared strain operator B~ (4.31)-(4.33).
+        mass: Lumped mass per unknown [kg per unit thickness].
+        dt: Time step [s].
+        cracks: The pre-existing cracks.
+    """
+
+    xs: np.ndarray
+    ys: np.ndarray
+    p: Particles
+    rk: RKApproximation
+    domains: NodalDomains
+    op: SmearedStrain
+    mass: np.ndarray
+    dt: float
+    cracks: Cracks
+
+    @property
+    def h(self) -> float:
+        """Largest grid spacing [m]."""
+        return float(max(np.diff(self.xs).max(), np.diff(self.ys).max()))
+
+
+def plate(xs: np.ndarray, ys: np.ndarray, slits: Sequence, tips: Sequence[tuple[bool, bool]],
+          material: dm.DamageMaterial, rho: float, support_factor: float = 1.5, courant: float = 0.5,
+          eps_p: float = 1.0) -> Plate:
+    """Particles, RK shape functions (linear basis, cubic B-spline kernel, support c h) with the
+    cracks ``slits`` (free tips flagged by ``tips``), SCNI cells with the MSCNI terms of weight
+    ``eps_p`` (0: plain SCNI), lumped mass and the CFL step."""
+    p = graded(xs, ys)
+    c = cracks([np.asarray(s, float) for s in slits], tips)
+    rk = rk_approximation(p.x, p.spacing, support_factor, cracks=c)
+    domains = grid_domains(xs, ys, slits)
+    op = smeared_strain(p, rk, domains, eps_p)
+    dt = stable_time_step(p.spacing, ElasticMaterial(material.E, material.nu), rho, courant)
+    return Plate(np.asarray(xs, float), np.asarray(ys, float), p, rk, domains, op, lumped_mass(domains.area, rho),
+                 dt, c)
+
+
+def damage_model(pl: Plate, material: dm.DamageMaterial, regularized: bool = True,
+                 kappa_c: float | None = None) -> dm.DamageModel:
+    """The damage particles of the plate: regularized (4.28) on the cells, or a constant kappa_c."""
+    geometry = dm.cell_geometry(pl.domains) if regularized else None
+    return dm.damage_model(material, pl.domains.area, geometry=geometry, kappa_c=kappa_c, regularized=regularized)
+
+
+def simulate(label: str, pl: Plate, model: dm.DamageModel, track: Tracking | None, constraints: Sequence[Constraint],
+             t_end: float, external_force: Callable[[float], np.ndarray] | None = None, samples: int = 200,
+             checkpoint_every: int = 0, work_dir: Path | None = None, resume: Path | None = None) -> DamageRun:
+    """The damage particle method on the plate to ``t_end`` (``rkfx.explicit_damage.run_damage``)."""
+    return run_damage(label, pl.op, pl.mass, pl.dt, model, track, constraints, t_end, external_force, samples,
+                      checkpoint_every, work_dir, resume)
+
+
+# --------------------------------------------------------------------------- crack metrics
+
+
+def crack_angle(x: np.ndarray, damage: np.ndarray, tip: np.ndarray, radius: float, threshold: float = 0.9) -> float:
+    """Angle [deg] from the +x axis of the line through ``tip`` fitted to the particles with
+    D >= ``threshold`` within ``radius`` of the tip (the major axis of their second moment
+    about the tip, pointing away from it); NaN with fewer than three such particles."""
+    d = x - np.asarray(tip, float)
+    sel = (damage >= threshold) & (np.linalg.norm(d, axis=1) <= radius)
+    if sel.sum() < 3:
+        return float("nan")
+    q = d[sel]
+    w, v = np.linalg.eigh(q.T @ q)
+    axis = v[:, np.argmax(w)]
+    if axis @ q.sum(axis=0) < 0:
+        axis = -axis
+    return float(np.degrees(np.arctan2(axis[1], axis[0])))
+
+
+def count_branches(damage: np.ndarray, nx: int, ny: int, columns: np.ndarray, threshold: float = 0.9,
+                   min_gap: int = 3) -> np.ndarray:
+    """Number of separate damaged bands crossing each grid column in ``columns``: runs of
+    particles with D >= ``threshold`` along the column, runs closer than ``min_gap`` rows merged."""
+    grid = damage.reshape(ny, nx) >= threshold
+    out = np.zeros(len(columns), int)
+    for k, i in enumerate(columns):
+        rows = np.flatnonzero(grid[:, i])
+        if rows.size:
+            out[k] = 1 + int(np.sum(np.diff(rows) > min_gap))
+    return out
+
+
+# --------------------------------------------------------------------------- figures
+
+
+def plot_dissipation(results, panels: Sequence[tuple[str, str]], path: Path, title: str,
+                     label: Callable, order: Callable, scale: float = 1.0, unit: str = "J/m") -> Path | None:
+    """Dissipation histories side by side, one panel per study present in ``results``.
+
+    Args:
+        panels: ``(study, panel title)`` pairs; studies without runs are skipped.
+        label, order: Line label and sort key of a run.
+        scale, unit: Energies are divided by ``scale`` and labelled in ``unit``.
+    """
+    from ._cli import pyplot, save  # noqa: PLC0415
+
+    panels = [(s, t) for s, t in panels if any(r.info.get("study") == s for r in results.runs)]
+    if not panels:
+        return None
+    plt = pyplot()
+    fig, axes = plt.subplots(1, len(panels), figsize=(4.7 * len(panels), 3.9), squeeze=False, sharey=True)
+    for ax, (study, head) in zip(axes[0], panels):
+        runs = sorted((r for r in results.runs if r.info.get("study") == study), key=order)
+        for k, r in enumerate(runs):
+            ax.plot(r.series["time_us"], np.asarray(r.series["dissipated"]) / scale,
+                    color=plt.cm.viridis(k / max(1, len(runs) - 1) * 0.85), label=label(r))
+        ax.set_title(head, fontsize=10)
+        ax.set_xlabel("time [µs]")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="upper left")
+    axes[0][0].set_ylabel(f"dissipated energy [{unit}]")
+    fig.suptitle(title, fontsize=11)
+    fig.tight_layout()
+    return save(fig, path)

@@ -1,0 +1,296 @@
+"""Dynamic crack branching by the damage particle method (seed 4.3.3, Fig 4.17-4.19).
+
+Problem (Fig 4.17). A pre-notched plate [0, 0.1] x [0, 0.04] m with an edge crack along
+y = a2 = 0.02 m from the left edge to x = a1 = 0.05 m. A uniform tensile traction
+sigma = 1 MPa acts on the top (+y) and bottom (-y) edges from t = 0 (a step, then held). The
+loads are self-equilibrated, so there are no displacement conditions: the explicit dynamics
+carries the free body. Soda-lime glass: E = 3.2e10 Pa, nu = 0.2, rho = 2450 kg/m^3,
+f_t = 2.72e6 Pa, G_F = 3 N/m, plane strain (``plane=stress`` for the thin-plate reading). The
+crack runs from the tip to the right and splits into two major branches that reach the right
+edge.
+
+Model. As ``rkfx.cases.kalthoff``: a tensor grid of nx x ny particles whose rectangular
+Voronoi cells (``rkfx.grid_cells``) have faces on the crack (nx and ny even, so x = a1 and
+y = a2 are midlines between particle columns and rows and the crack tip is a cell corner);
+the grid sizes are the even numbers whose spacing is nearest to each requested ``h``. RK shape
+functions with the crack by diffraction (linear basis, cubic B-spline kernel, support 1.75 h:
+the crack mouth at the free edge x = 0 needs more than 1.5 h, see ``kalthoff``), SCNI
+smeared strains with the MSCNI stabilization (weight ``eps_p``; ``rkfx.explicit_damage``
+explains why dynamics needs it: with plain SCNI the 0.4 mm model grows a central crack
+between the two branches and striped damage), the damage law (4.2) with Mazars' equivalent strain, the regularization
+kappa_c = (G_F / f_t) A_L / V_L (4.28) and particle tracking (4.22) with tol = 0.5; the
+particles within 0.75 h of the crack tip are the seeds. The traction load is the RK boundary
+integral f_I = sum over the top and bottom half-segments of N_I(midpoint) t length
+(``rkfx.boundary.traction_load``, SCNI's one-point rule). Central differences with the lumped
+mass and dt = 0.5 h / c_d (``rkfx.explicit``) to ``t_end`` = 80 microseconds.
+
+Studies (``h`` lists nominal spacings [m]):
+
+* ``rkpm-dpm``: the damage particle method at every ``h`` (Fig 4.18, 4.19b);
+* ``rkpm-dpm-unregularized``: a constant kappa_c = G_F / (f_t h_0), h_0 the spacing of the
+  coarsest model, at ``unregularized_h`` (Fig 4.19a).
+
+There is no finite element baseline for this case: ``--method fem`` runs nothing (with a
+one-line note) and ``--method both`` runs the RKPM studies.
+
+Metrics per run: ``branches``, the number of major branches (``count_branches`` across every
+grid column in x = 0.08-0.095 m; the most frequent nonzero count, ties to the larger), ``branch_x`` [m], the
+smallest x > a1 where a column is crossed by two or more separate failed bands (where the
+crack first splits; NaN if it never does), ``tip_x`` [m], the largest x of the particles
+with D >= 0.9, ``dissipated_end`` [J/m] with its history, and ``energy_error`` (max |energy
+balance| / max energy). A summary run per study maps h to branches and final dissipation
+and gives ``dissipation_change_fine``, |W_d(finest) - W_d(second finest)| / W_d(finest).
+
+Parameters (``--set NAME=VALUE``, SI units): E, nu, rho, ft, GF, sigma, plane, t_end, tol, h,
+unregularized_h, support_factor, courant, radius, eps_p. Long runs: ``--checkpoint-every N`` writes
+each model's state every N steps to OUT/checkpoints/, and ``--resume DIR`` continues an
+interrupted invocation (finished models are read back).
+
+    python -m rkfx.cases.crack_branching [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
+"""
+import sys
+from collections import Counter
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from .. import damage as dm
+from ..boundary import Traction, boundary_quadrature, traction_load
+from ..crack_tracking import tracking
+from ..errors import InputError
+from ..explicit_damage import DamageRun
+from . import _cli
+from . import _dynamic_fracture as dyn
+from ._cli import Param, Results, Run
+
+NAME = "crack_branching"
+LX, LY, A1, A2 = 0.1, 0.04, 0.05, 0.02
+BRANCH_WINDOW = (0.08, 0.095)  # columns where the branches are counted [m]
+
+PARAMS = {
+    "E": Param(3.2e10, "Young's modulus [Pa]"),
+    "nu": Param(0.2, "Poisson's ratio"),
+    "rho": Param(2450.0, "density [kg/m^3]"),
+    "ft": Param(2.72e6, "tensile strength f_t [Pa]"),
+    "GF": Param(3.0, "fracture energy G_F [N/m]"),
+    "sigma": Param(1.0e6, "traction on the top and bottom edges, a step at t = 0 [Pa]"),
+    "plane": Param("strain", "2-D idealization: strain or stress"),
+    "t_end": Param(80e-6, "end time [s]"),
+    "tol": Param(0.5, "particle tracking tolerance of (4.22)"),
+    "h": Param([8e-4, 4e-4, 2e-4], "nominal nodal spacings of the regularized models [m]"),
+    "unregularized_h": Param([8e-4, 4e-4, 2e-4], "nominal nodal spacings of the constant-kappa_c models [m]"),
+    "support_factor": Param(1.75, "RK support radius / nodal spacing (>= 1.6: see rkfx.cases.kalthoff)"),
+    "courant": Param(0.5, "dt = courant * h / c_d"),
+    "radius": Param(3.5, "tracking neighbourhood radius / nodal spacing"),
+    "eps_p": Param(1.0, "weight of the MSCNI stabilization (0: plain SCNI)"),
+}
+QUICK = {"h": [1.6e-3, 8e-4], "unregularized_h": [1.6e-3, 8e-4]}
+
+
+def _even(length: float, h: float) -> int:
+    """The even number of grid points over ``length`` whose spacing is nearest to ``h``."""
+    m = length / h + 1.0
+    lo = max(2, 2 * int(np.floor(m / 2)))
+    return min((lo, lo + 2), key=lambda n: abs(length / (n - 1) - h))
+
+
+def grid(h: float) -> tuple[np.ndarray, np.ndarray]:
+    """Grid lines with spacing about ``h`` whose cell faces hold the crack: nx and ny even
+    (x = a1 a column midline, y = a2 a row midline)."""
+    return np.linspace(0.0, LX, _even(LX, h)), np.linspace(0.0, LY, _even(LY, h))
+
+
+def _check(E, nu, rho, ft, GF, sigma, plane, t_end, tol, hs, support_factor, courant, radius):
+    for name, v in (("rho", rho), ("sigma", sigma), ("t_end", t_end)):
+        if not (np.isfinite(v) and v > 0):
+            raise InputError(f"{name} = {v!r} must be positive")
+    material = dm.DamageMaterial(E, nu, ft, GF, plane)
+    if not (0.0 < tol <= 1.0):
+        raise InputError(f"tol = {tol!r} must lie in (0, 1] (the seed uses 0.5)")
+    if not support_factor >= 1.6:
+        raise InputError(f"support_factor = {support_factor!r}: use >= 1.6 (the crack mouth at x = 0 needs it)")
+    if not 0 < courant <= 1.0:
+        raise InputError(f"courant = {courant!r} must lie in (0, 1]")
+    for h in hs:
+        if not (np.isfinite(h) and 0 < h <= LY / 20):
+            raise InputError(f"h = {h!r} m: use 0 < h <= {LY / 20:g} m (at least 20 spacings across the plate)")
+        if not h >= 5e-5:
+            raise InputError(f"h = {h!r} m is finer than 5e-5 m (over 1.6 million particles); refused")
+    if hs:
+        h0 = max(hs)
+        if not material.critical_opening / 2 / h0 > material.kappa0:
+            raise InputError(f"h = {h0:g} m is too coarse for G_F: kappa_c = G_F / (f_t h) <= kappa0; use "
+                             f"h < E G_F / f_t^2 = {E * GF / ft**2:.3g} m")
+    return material
+
+
+def traction_force(pl: dyn.Plate, sigma: float) -> np.ndarray:
+    """f_I = int N_I sigma n dGamma over the top and bottom edges (SCNI's midpoint rule), shape (2 n,)."""
+    bq = boundary_quadrature(pl.p, pl.domains, pl.rk)
+    pull = lambda x, n: sigma * n  # noqa: E731 - t = sigma n: +y on top, -y on bottom
+    return traction_load(pl.p, bq, [Traction("top", pull), Traction("bottom", pull)])
+
+
+def _rkpm(label, study, h, material, prm, regularized=True, kappa_c=None, **io) -> Run:
+    xs, ys = grid(h)
+    pl = dyn.plate(xs, ys, [((0.0, A2), (A1, A2))], [(False, True)], material, prm["rho"], prm["support_factor"],
+                   prm["courant"], prm["eps_p"])
+    seeds = np.linalg.norm(pl.p.x - np.array([A1, A2]), axis=1) < 0.75 * pl.h
+    track = tracking(pl.p.x, pl.p.spacing, prm["tol"], seeds, prm["radius"])
+    model = dyn.damage_model(pl, material, regularized, kappa_c)
+    f = traction_force(pl, prm["sigma"])
+    r = dyn.simulate(label, pl, model, track, [], prm["t_end"], external_force=lambda t: f, **io)
+    return _run_record(r, study, h, pl, 2 * pl.p.num_nodes)
+
+
+def branch_metrics(damage: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> tuple[int, float, np.ndarray]:
+    """(branches, branch_x, counts): the most frequent nonzero number of failed bands across the
+    columns in ``BRANCH_WINDOW`` (0 if none), the smallest column x > a1 crossed by two or more
+    bands (NaN if none), and the band count of every column x > a1."""
+    nx, ny = len(xs), len(ys)
+    right = np.flatnonzero(xs > A1)
+    counts = dyn.count_branches(damage, nx, ny, right)
+    window = (xs[right] >= BRANCH_WINDOW[0] - 1e-12) & (xs[right] <= BRANCH_WINDOW[1] + 1e-12)
+    nonzero = [int(c) for c in counts[window] if c > 0]
+    # Mode; a tie goes to the larger count.
+    branches = max(Counter(nonzero).items(), key=lambda kv: (kv[1], kv[0]))[0] if nonzero else 0
+    split = np.flatnonzero(counts >= 2)
+    branch_x = float(xs[right[split[0]]]) if split.size else float("nan")
+    return branches, branch_x, counts
+
+
+def _run_record(r: DamageRun, study, h, pl: dyn.Plate, dofs) -> Run:
+    x = pl.p.x
+    branches, branch_x, counts = branch_metrics(r.damage, pl.xs, pl.ys)
+    failed = r.damage >= 0.9
+    tip_x = float(x[failed, 0].max()) if failed.any() else float("nan")
+    hist = r.history
+    # Crack tip history: the largest x of the particles (finally failed) initiated by each sample time.
+    t_init = np.where(failed, r.initiation_time, np.inf)
+    tip_hist = np.array([x[s, 0].max() if (s := t_init <= t + 0.5 * r.dt).any() else np.nan for t in hist[:, 0]])
+    damaged = np.flatnonzero(r.damage > 0.01)
+    series = {"time_us": 1e6 * hist[:, 0], "dissipated": hist[:, 1], "damaged": hist[:, 2],
+              "kinetic": hist[:, 3], "internal": hist[:, 4], "external": hist[:, 5], "tip_x": tip_hist,
+              "column_x": pl.xs[pl.xs > A1], "column_bands": counts,
+              "damaged_index": damaged, "damaged_D": np.round(r.damage[damaged], 4)}
+    errors = {"branches": branches, "branch_x": branch_x, "tip_x": tip_x, "dissipated_end": float(hist[-1, 1]),
+              "energy_error": r.energy_error}
+    info = {"study": study, "h_nominal": h, "nx": len(pl.xs), "ny": len(pl.ys), "h": pl.h, "steps": r.steps,
+            "dt": r.dt}
+    return Run(r.label, r.wall_time_s, dofs, series, errors, info)
+
+
+def _summary(study: str, runs: Sequence[Run]) -> Run:
+    runs = sorted(runs, key=lambda r: -r.info["h"])  # coarse to fine
+    key = lambda r: f"{r.info['h_nominal']:g}"  # noqa: E731
+    diss = [r.errors["dissipated_end"] for r in runs]
+    change = abs(diss[-1] - diss[-2]) / diss[-1] if len(runs) >= 2 and diss[-1] > 0 else float("nan")
+    return Run(study, float(sum(r.wall_time_s for r in runs)), max(r.n_dofs for r in runs),
+               series={"branches": {key(r): r.errors["branches"] for r in runs},
+                       "dissipated_end": {key(r): d for r, d in zip(runs, diss)},
+                       "wall_time_s": {key(r): r.wall_time_s for r in runs},
+                       "dissipation_history": {key(r): {"time_us": r.series["time_us"],
+                                                        "dissipated": r.series["dissipated"]} for r in runs}},
+               errors={"dissipation_change_fine": change,
+                       "dissipation_spread": float(max(diss) / min(diss) - 1) if min(diss) > 0 else float("inf")},
+               info={"study": "summary", "of": study})
+
+
+def run(*, methods: Sequence[str] = ("rkpm",), E=3.2e10, nu=0.2, rho=2450.0, ft=2.72e6, GF=3.0, sigma=1.0e6,
+        plane="strain", t_end=80e-6, tol=0.5, h=(8e-4, 4e-4, 2e-4), unregularized_h=(8e-4, 4e-4, 2e-4),
+        support_factor=1.75, courant=0.5, radius=3.5, eps_p=1.0, checkpoint_every=0, work_dir=None,
+        resume=None) -> Results:
+    """The damage particle method, regularized and with a constant kappa_c, at each spacing."""
+    hs, unreg = [float(v) for v in h], [float(v) for v in unregularized_h]
+    material = _check(E, nu, rho, ft, GF, sigma, plane, t_end, tol, hs + unreg, support_factor, courant, radius)
+    prm = dict(E=E, nu=nu, rho=rho, ft=ft, GF=GF, sigma=sigma, plane=plane, t_end=t_end, tol=tol, h=hs,
+               unregularized_h=unreg, support_factor=support_factor, courant=courant, radius=radius, eps_p=eps_p)
+    io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume}
+    xs, ys = grid(max(hs + unreg) if hs + unreg else 8e-4)
+    h0 = float(max(np.diff(xs).max(), np.diff(ys).max()))
+    kappa_c = GF / (ft * h0)
+    results = Results(NAME, {**prm, "kappa0": material.kappa0, "kappa_c_unregularized": kappa_c})
+    if "rkpm" not in methods:
+        if _cli._rank() == 0:
+            print(f"{NAME}: no finite element baseline for this case; --method fem runs nothing "
+                  "(use --method rkpm or both)", file=sys.stderr)
+        return results
+    for study, levels, kw in (("rkpm-dpm", hs, {}),
+                              ("rkpm-dpm-unregularized", unreg, {"regularized": False, "kappa_c": kappa_c})):
+        runs = [_rkpm(f"{study} h={v:g}", study, v, material, prm, **kw, **io) for v in _cli.progress(levels, study)]
+        results.runs += runs
+        if runs:
+            results.runs.append(_summary(study, runs))
+    return results
+
+
+# --------------------------------------------------------------------------- figures
+
+
+def _damage_map(ax, r: Run):
+    nx, ny = r.info["nx"], r.info["ny"]
+    d = np.zeros(nx * ny)
+    d[np.asarray(r.series["damaged_index"], int)] = r.series["damaged_D"]
+    xs, ys = np.linspace(0, LX, nx), np.linspace(0, LY, ny)
+    xe = np.r_[xs[0], 0.5 * (xs[1:] + xs[:-1]), xs[-1]]
+    ye = np.r_[ys[0], 0.5 * (ys[1:] + ys[:-1]), ys[-1]]
+    m = ax.pcolormesh(xe, ye, d.reshape(ny, nx), cmap="inferno_r", vmin=0, vmax=1, rasterized=True)
+    ax.plot([0, A1], [A2, A2], color="tab:blue", lw=2)
+    for xb in BRANCH_WINDOW:
+        ax.axvline(xb, color="tab:green", lw=0.8, ls=":")
+    bx = r.errors.get("branch_x")
+    if bx is not None and np.isfinite(bx):
+        ax.axvline(bx, color="tab:cyan", lw=0.8, ls="--")
+    ax.set_xlim(0, LX)
+    ax.set_ylim(0, LY)
+    ax.set_aspect("equal")
+    ax.set_xticks([0, 0.025, 0.05, 0.075, 0.1])
+    ax.set_yticks([0, 0.02, 0.04])
+    return m
+
+
+def _title(r: Run) -> str:
+    e = r.errors
+    bx = e["branch_x"]
+    split = f", splits at x = {1e3 * bx:.0f} mm" if bx is not None and np.isfinite(bx) else ""
+    return (f"h = {1e3 * r.info['h']:.3f} mm ({r.info['nx']} x {r.info['ny']} particles): {e['branches']} "
+            f"branch(es){split}, dissipated {e['dissipated_end']:.3f} J/m")
+
+
+def plot(results: Results, out: Path) -> list[Path]:
+    plt = _cli.pyplot()
+    out = Path(out)
+    files = []
+    t_us = 1e6 * results.params["t_end"]
+    for study, fname, head in (("rkpm-dpm", "damage", "damage particle method (regularized)"),
+                               ("rkpm-dpm-unregularized", "damage_unregularized", "constant $\\kappa_c$")):
+        runs = sorted((r for r in results.runs if r.info.get("study") == study), key=lambda r: -r.info["h"])
+        if not runs:
+            continue
+        fig, axes = plt.subplots(len(runs), 1, figsize=(7.6, 2.5 * len(runs) + 0.7), squeeze=False,
+                                 layout="constrained")
+        for ax, r in zip(axes[:, 0], runs):
+            m = _damage_map(ax, r)
+            ax.set_title(_title(r), fontsize=8.5)
+        fig.colorbar(m, ax=list(axes[:, 0]), label="damage D", shrink=0.9 if len(runs) > 1 else 0.7)
+        fig.suptitle(f"crack branching, {head}: damage at t = {t_us:.0f} µs\n(green: columns where branches are "
+                     "counted; cyan: first split)", fontsize=10)
+        files.append(_cli.save(fig, out / f"{fname}.png"))
+    path = dyn.plot_dissipation(
+        results, (("rkpm-dpm-unregularized", "(a) unregularized: constant $\\kappa_c$"),
+                  ("rkpm-dpm", "(b) damage particle method, regularized (4.28)")),
+        out / "dissipation.png", "crack branching: global fracture energy dissipation",
+        label=lambda r: f"h = {1e3 * r.info['h']:.3f} mm", order=lambda r: -r.info["h"])
+    if path:
+        files.append(path)
+    return files
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Command-line entry point (see the module docstring)."""
+    return _cli.main(NAME, __doc__, PARAMS, run, plot, argv, QUICK, checkpoints=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
