@@ -126,7 +126,27 @@ def count_branches(damage: np.ndarray, nx: int, ny: int, columns: np.ndarray, th
     return out
 
 
+def run_series(r: DamageRun) -> dict:
+    """The series every dynamic fracture run reports: the sampled history (time in µs) and the
+    damaged particles (D > 0.01) as indices and values, which ``damage_map`` draws."""
+    hist = r.history
+    damaged = np.flatnonzero(r.damage > 0.01)
+    return {"time_us": 1e6 * hist[:, 0], "dissipated": hist[:, 1], "damaged": hist[:, 2], "kinetic": hist[:, 3],
+            "internal": hist[:, 4], "external": hist[:, 5], "damaged_index": damaged,
+            "damaged_D": np.round(r.damage[damaged], 4)}
+
+
 # --------------------------------------------------------------------------- figures
+
+
+def damage_map(ax, series: dict, nx: int, ny: int, lx: float, ly: float):
+    """Damage on the grid's cells (pcolormesh) from ``run_series``; returns the mesh artist."""
+    d = np.zeros(nx * ny)
+    d[np.asarray(series["damaged_index"], int)] = series["damaged_D"]
+    xs, ys = np.linspace(0, lx, nx), np.linspace(0, ly, ny)
+    xe = np.r_[xs[0], 0.5 * (xs[1:] + xs[:-1]), xs[-1]]
+    ye = np.r_[ys[0], 0.5 * (ys[1:] + ys[:-1]), ys[-1]]
+    return ax.pcolormesh(xe, ye, d.reshape(ny, nx), cmap="inferno_r", vmin=0, vmax=1, rasterized=True)
 
 
 def plot_dissipation(results, panels: Sequence[tuple[str, str]], path: Path, title: str,

@@ -169,11 +169,7 @@ def _run_record(r: DamageRun, study, h, pl: dyn.Plate, dofs) -> Run:
     # Crack tip history: the largest x of the particles (finally failed) initiated by each sample time.
     t_init = np.where(failed, r.initiation_time, np.inf)
     tip_hist = np.array([x[s, 0].max() if (s := t_init <= t + 0.5 * r.dt).any() else np.nan for t in hist[:, 0]])
-    damaged = np.flatnonzero(r.damage > 0.01)
-    series = {"time_us": 1e6 * hist[:, 0], "dissipated": hist[:, 1], "damaged": hist[:, 2],
-              "kinetic": hist[:, 3], "internal": hist[:, 4], "external": hist[:, 5], "tip_x": tip_hist,
-              "column_x": pl.xs[pl.xs > A1], "column_bands": counts,
-              "damaged_index": damaged, "damaged_D": np.round(r.damage[damaged], 4)}
+    series = {**dyn.run_series(r), "tip_x": tip_hist, "column_x": pl.xs[pl.xs > A1], "column_bands": counts}
     errors = {"branches": branches, "branch_x": branch_x, "tip_x": tip_x, "dissipated_end": float(hist[-1, 1]),
               "energy_error": r.energy_error}
     info = {"study": study, "h_nominal": h, "nx": len(pl.xs), "ny": len(pl.ys), "h": pl.h, "steps": r.steps,
@@ -229,13 +225,7 @@ def run(*, methods: Sequence[str] = ("rkpm",), E=3.2e10, nu=0.2, rho=2450.0, ft=
 
 
 def _damage_map(ax, r: Run):
-    nx, ny = r.info["nx"], r.info["ny"]
-    d = np.zeros(nx * ny)
-    d[np.asarray(r.series["damaged_index"], int)] = r.series["damaged_D"]
-    xs, ys = np.linspace(0, LX, nx), np.linspace(0, LY, ny)
-    xe = np.r_[xs[0], 0.5 * (xs[1:] + xs[:-1]), xs[-1]]
-    ye = np.r_[ys[0], 0.5 * (ys[1:] + ys[:-1]), ys[-1]]
-    m = ax.pcolormesh(xe, ye, d.reshape(ny, nx), cmap="inferno_r", vmin=0, vmax=1, rasterized=True)
+    m = dyn.damage_map(ax, r.series, r.info["nx"], r.info["ny"], LX, LY)
     ax.plot([0, A1], [A2, A2], color="tab:blue", lw=2)
     for xb in BRANCH_WINDOW:
         ax.axvline(xb, color="tab:green", lw=0.8, ls=":")

@@ -139,12 +139,8 @@ def _run_record(r: DamageRun, study, n, x, shape, h, prm, dofs, method=None) -> 
     tip = np.array([A1, A2])
     angle = dyn.crack_angle(x, r.damage, tip, prm["angle_radius"])
     below = int(np.sum((r.damage >= 0.9) & (x[:, 1] < A2 - 3 * h)))
-    hist = r.history
-    damaged = np.flatnonzero(r.damage > 0.01)
-    series = {"time_us": 1e6 * hist[:, 0], "dissipated": hist[:, 1], "damaged": hist[:, 2],
-              "kinetic": hist[:, 3], "internal": hist[:, 4], "external": hist[:, 5],
-              "damaged_index": damaged, "damaged_D": np.round(r.damage[damaged], 4)}
-    errors = {"crack_angle_deg": angle, "dissipated_end": float(hist[-1, 1]), "failed_below_crack_plane": below,
+    series = dyn.run_series(r)
+    errors = {"crack_angle_deg": angle, "dissipated_end": float(r.history[-1, 1]), "failed_below_crack_plane": below,
               "energy_error": r.energy_error}
     info = {"study": study, "nodes": n, "nx": shape[0], "ny": shape[1], "h": h, "steps": r.steps, "dt": r.dt}
     return Run(method or r.label, r.wall_time_s, dofs, series, errors, info)
@@ -222,14 +218,8 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.9e11, nu=0.3, rho=8000.
 # --------------------------------------------------------------------------- figures
 
 
-def _damage_map(ax, r: Run, side=SIDE):
-    nx, ny = r.info["nx"], r.info["ny"]
-    d = np.zeros(nx * ny)
-    d[np.asarray(r.series["damaged_index"], int)] = r.series["damaged_D"]
-    xs, ys = np.linspace(0, side, nx), np.linspace(0, side, ny)
-    xe = np.r_[xs[0], 0.5 * (xs[1:] + xs[:-1]), xs[-1]]
-    ye = np.r_[ys[0], 0.5 * (ys[1:] + ys[:-1]), ys[-1]]
-    return ax.pcolormesh(xe, ye, d.reshape(ny, nx), cmap="inferno_r", vmin=0, vmax=1, rasterized=True)
+def _damage_map(ax, r: Run):
+    return dyn.damage_map(ax, r.series, r.info["nx"], r.info["ny"], SIDE, SIDE)
 
 
 def _decorate(ax, r: Run, title: str):
