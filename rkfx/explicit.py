@@ -54,7 +54,7 @@ from .errors import InputError
 from .nodal_domains import NodalDomains, nodal_domains
 from .operators import strain_matrix
 from .particles import Particles
-from .quadrature import smoothed_gradients
+from .quadrature import smoothed_gradients, subcell_gradients
 from .shape_functions import RKApproximation
 from .sparse_rows import SparseRows
 
@@ -97,6 +97,57 @@ def _force(indptr, indices, grad, stress, volume, out):
             fy += gy * stress[ell, 1] + gx * stress[ell, 2]
         out[2 * node] = fx
         out[2 * node + 1] = fy
+
+
+@numba.njit(parallel=True, cache=True)
+def _cell_average(ptr, fraction, sub):
+    """Cell strains e_L = sum_C (A_C / A_L) e_C from the subcell strains of each particle,
+    shape ``(n, 3)``; ``sub`` becomes the differences e_L - e_C in place."""
+    n = len(ptr) - 1
+    cell = np.empty((n, 3))
+    for ell in numba.prange(n):
+        a0 = 0.0
+        a1 = 0.0
+        a2 = 0.0
+        for c in range(ptr[ell], ptr[ell + 1]):
+            f = fraction[c]
+            a0 += f * sub[c, 0]
+            a1 += f * sub[c, 1]
+            a2 += f * sub[c, 2]
+        cell[ell, 0] = a0
+        cell[ell, 1] = a1
+        cell[ell, 2] = a2
+        for c in range(ptr[ell], ptr[ell + 1]):
+            sub[c, 0] = a0 - sub[c, 0]
+            sub[c, 1] = a1 - sub[c, 1]
+            sub[c, 2] = a2 - sub[c, 2]
+    return cell
+
+
+@numba.njit(parallel=True, cache=True)
+def _subcell_load(ptr, fraction, weight, volume, stress, sub_stress, out):
+    """tau_C = (A_C / A_L) (V_L Sigma_L + sum_C' w_C' s_C') - w_C s_C per subcell C of each
+    particle L: the stresses whose transposed subcell product is the whole force
+    (``sub_stress`` empty: no MSCNI terms)."""
+    with_sub = sub_stress.shape[0] > 0
+    for ell in numba.prange(len(ptr) - 1):
+        t0 = volume[ell] * stress[ell, 0]
+        t1 = volume[ell] * stress[ell, 1]
+        t2 = volume[ell] * stress[ell, 2]
+        if with_sub:
+            for c in range(ptr[ell], ptr[ell + 1]):
+                t0 += weight[c] * sub_stress[c, 0]
+                t1 += weight[c] * sub_stress[c, 1]
+                t2 += weight[c] * sub_stress[c, 2]
+        for c in range(ptr[ell], ptr[ell + 1]):
+            f = fraction[c]
+            out[c, 0] = f * t0
+            out[c, 1] = f * t1
+            out[c, 2] = f * t2
+            if with_sub:
+                out[c, 0] -= weight[c] * sub_stress[c, 0]
+                out[c, 1] -= weight[c] * sub_stress[c, 1]
+                out[c, 2] -= weight[c] * sub_stress[c, 2]
 
 
 @numba.njit(cache=True)
@@ -183,23 +234,38 @@ def _transpose(rows: SparseRows) -> SparseRows:
 
 @dataclass(frozen=True)
 class Stabilization:
-    """The MSCNI stabilization of eq. (3.56) for explicit dynamics.
+    """The MSCNI stabilization of eq. (3.56) for explicit dynamics, and the subcell rows that
+    evaluate the whole operator.
 
     Per subcell C of particle L, the strain difference (B~_L - B~_C) d between the cell's
     smoothed strain and the subcell's, weighted by eps_p A_C: the force
     sum_C (B~_L - B~_C)^T s_L C (B~_L - B~_C) d eps_p A_C penalizes the zero-energy modes of
     SCNI (the checkerboards of a nodal grid), with s_L = 1 - D_L under damage.
 
+    The subcells partition the cell and their interior sides cancel, so
+    A_L B~_L = sum_C A_C B~_C: one product with the subcell rows gives the subcell strains,
+    their area average the cell strains, and the force with the cell stresses Sigma_L and the
+    subcell stresses s_C is one transposed product of the subcell rows with
+    tau_C = (A_C / A_L) (V_L Sigma_L + sum_C' eps_p A_C' s_C') - eps_p A_C s_C.
+
     Attributes:
-        rows, rows_t: grad~N_I(x_L) - grad~N_I(x_C) per subcell, and transposed.
+        rows, rows_t: grad~N_I(x_hat_C) per subcell, grouped by particle, and transposed.
+        ptr: The subcells of particle L are rows ``ptr[L]:ptr[L+1]``, shape ``(n + 1,)``.
         owner: Particle L of each subcell, shape ``(num_subcells,)``.
+        fraction: A_C / A_L, shape ``(num_subcells,)``.
         weight: eps_p A_C, shape ``(num_subcells,)`` [m^2].
     """
 
     rows: SparseRows
     rows_t: SparseRows
+    ptr: np.ndarray
     owner: np.ndarray
+    fraction: np.ndarray
     weight: np.ndarray
+
+    @cached_property
+    def _unit(self) -> np.ndarray:
+        return np.ones(len(self.owner))
 
 
 @dataclass(frozen=True)
@@ -209,7 +275,10 @@ class SmearedStrain:
     Stored as the smoothed gradient rows grad~N_I(x_L) (2 numbers and a node index per
     entry) and their transpose, which is all B~ d and B~^T Sigma V read: 20 bytes per entry
     against 48 for B~ as a (3 n, 2 n) CSR matrix, and both products are memory bound. The
-    CSR matrices are built on demand (``B``, ``BT``), e.g. for a tangent stiffness.
+    CSR matrices are built on demand (``B``, ``BT``), e.g. for a tangent stiffness. With the
+    MSCNI terms the products run over the subcell rows instead (``Stabilization``): one
+    product each way gives cell strains, subcell differences and the whole force, about 40%
+    fewer entries than the cell rows plus the difference rows.
 
     Attributes:
         rows: grad~N_I(x_L) per node L, shape ``(n, n)`` with 2 components [1/m].
@@ -230,20 +299,34 @@ class SmearedStrain:
     def strain(self, d: np.ndarray) -> np.ndarray:
         """Smeared strains (eps_xx, eps_yy, gamma_xy) at the nodes, shape ``(n, 3)``, for
         interleaved coefficients d of shape ``(2 n,)`` [m]."""
+        if self.stabilization is not None:
+            return self.strains(d)[0]
         return _apply(self.rows, d)
 
-    def force(self, stress: np.ndarray) -> np.ndarray:
-        """f_int = sum_L B~_L^T Sigma_L V_L (eq. 4.34) for nodal stresses ``(n, 3)`` [Pa]; shape ``(2 n,)`` [N]."""
-        return _apply_t(self.rows_t, stress, self.volume)
-
-    def subcell_strain(self, d: np.ndarray) -> np.ndarray:
-        """Strain differences (B~_L - B~_C) d per subcell, shape ``(num_subcells, 3)``."""
-        return _apply(self.stabilization.rows, d)
-
-    def subcell_force(self, stress: np.ndarray) -> np.ndarray:
-        """sum_C (B~_L - B~_C)^T stress_C eps_p A_C for subcell stresses ``(num_subcells, 3)`` [N]."""
+    def strains(self, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The smeared strains ``(n, 3)`` and the MSCNI differences (B~_L - B~_C) d per subcell
+        ``(num_subcells, 3)``, from one product with the subcell rows."""
         s = self.stabilization
-        return _apply_t(s.rows_t, stress, s.weight)
+        if s is None:
+            raise InputError("this operator has no MSCNI terms; build it with smeared_strain(..., eps_p=1)")
+        sub = _apply(s.rows, d)
+        return _cell_average(s.ptr, s.fraction, sub), sub
+
+    def force(self, stress: np.ndarray, subcell_stress: np.ndarray | None = None) -> np.ndarray:
+        """f_int = sum_L B~_L^T Sigma_L V_L (eq. 4.34) for nodal stresses ``(n, 3)`` [Pa], plus
+        sum_C (B~_L - B~_C)^T s_C eps_p A_C for subcell stresses s_C ``(num_subcells, 3)``
+        (MSCNI operators only); shape ``(2 n,)`` [N]."""
+        s = self.stabilization
+        stress = np.ascontiguousarray(stress, dtype=np.float64)
+        if s is None:
+            if subcell_stress is not None:
+                raise InputError("subcell stresses given to an operator without MSCNI terms")
+            return _apply_t(self.rows_t, stress, self.volume)
+        sub = np.empty((0, 3)) if subcell_stress is None else \
+            np.ascontiguousarray(subcell_stress, dtype=np.float64)
+        load = np.empty((len(s.owner), 3))
+        _subcell_load(s.ptr, s.fraction, s.weight, self.volume, stress, sub, load)
+        return _apply_t(s.rows_t, load, s._unit)
 
     @cached_property
     def B(self) -> sp.csr_matrix:
@@ -268,6 +351,11 @@ def _apply_t(rows_t: SparseRows, stress: np.ndarray, weight: np.ndarray) -> np.n
     return out
 
 
+# Largest relative mismatch between the cell strains and the area average of the subcell
+# strains accepted at set-up (round-off is ~1e-14).
+_PARTITION_TOL = 1e-9
+
+
 def smeared_strain(p: Particles, rk: RKApproximation, domains: NodalDomains | None = None,
                    eps_p: float = 0.0) -> SmearedStrain:
     """B~ from the SCNI smoothed gradients on the nodal cells (eq. 3.55 = eq. 4.33), with the
@@ -275,14 +363,25 @@ def smeared_strain(p: Particles, rk: RKApproximation, domains: NodalDomains | No
     if not (np.isfinite(eps_p) and eps_p >= 0):
         raise InputError(f"eps_p = {eps_p!r} must be >= 0 (0: plain SCNI, 1: MSCNI)")
     domains = domains or nodal_domains(p)
-    s = smoothed_gradients(p, rk, domains, subcells=eps_p > 0)
-    cell = s.cell
-    stab = None
-    if eps_p > 0:
-        diff = s.cell_minus_subcell
-        stab = Stabilization(diff, _transpose(diff), np.ascontiguousarray(domains.subcell_node),
-                             np.ascontiguousarray(eps_p * domains.subcell_area, dtype=np.float64))
-    return SmearedStrain(cell, _transpose(cell), np.ascontiguousarray(domains.area, dtype=np.float64), stab)
+    volume = np.ascontiguousarray(domains.area, dtype=np.float64)
+    if eps_p == 0:
+        cell = smoothed_gradients(p, rk, domains, subcells=False).cell
+        return SmearedStrain(cell, _transpose(cell), volume)
+    cell, sub, order = subcell_gradients(rk, domains)
+    owner = np.ascontiguousarray(domains.subcell_node[order])
+    ptr = np.zeros(p.num_nodes + 1, np.int64)
+    np.cumsum(np.bincount(owner, minlength=p.num_nodes), out=ptr[1:])
+    area = domains.subcell_area[order]
+    stab = Stabilization(sub, _transpose(sub), ptr, owner, np.ascontiguousarray(area / volume[owner]),
+                         np.ascontiguousarray(eps_p * area, dtype=np.float64))
+    op = SmearedStrain(cell, _transpose(cell), volume, stab)
+    probe = np.random.default_rng(0).standard_normal(2 * p.num_nodes)
+    direct = _apply(cell, probe)
+    gap = np.abs(op.strain(probe) - direct).max() / max(np.abs(direct).max(), 1e-300)
+    if not gap <= _PARTITION_TOL:
+        raise InputError(f"the subcells do not partition the nodal cells (cell and subcell strains differ by "
+                         f"{gap:.1e}); use eps_p=0 with these domains or rebuild them with nodal_domains/grid_domains")
+    return op
 
 
 def elastic_force(op: SmearedStrain, d_matrix: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
@@ -294,17 +393,18 @@ def elastic_force(op: SmearedStrain, d_matrix: np.ndarray) -> Callable[[np.ndarr
 
     c = np.ascontiguousarray(c)
 
-    def f_int(d: np.ndarray) -> np.ndarray:
-        e = op.strain(d)
-        sigma = np.empty_like(e)
-        _linear_stress(e, c, sigma)  # not e @ c.T: BLAS threads would fight numba's
-        f = op.force(sigma)
-        if op.stabilization is not None:
-            e = op.subcell_strain(d)
+    def f_int(d: np.ndarray) -> np.ndarray:  # _linear_stress, not e @ c.T: BLAS threads would fight numba's
+        if op.stabilization is None:
+            e = op.strain(d)
             sigma = np.empty_like(e)
             _linear_stress(e, c, sigma)
-            f += op.subcell_force(sigma)
-        return f
+            return op.force(sigma)
+        e, diff = op.strains(d)
+        sigma = np.empty_like(e)
+        _linear_stress(e, c, sigma)
+        sub = np.empty_like(diff)
+        _linear_stress(diff, c, sub)
+        return op.force(sigma, sub)
     return f_int
 
 

@@ -12,7 +12,9 @@ central-difference driver of ``rkfx.explicit``:
    neighbours satisfying (4.22) become candidates;
 4. the smeared stress (1 - D) C e~ (4.30) and f_int = sum_L B~_L^T Sigma_L V_L (4.34);
 5. with the MSCNI terms of eq. (3.56) in the operator (``smeared_strain(..., eps_p)``), the
-   subcell strain differences (B~_L - B~_C) d and their force with (1 - D_L) C eps_p A_C.
+   subcell strain differences (B~_L - B~_C) d and their force with (1 - D_L) C eps_p A_C;
+   steps 1 and 4 then run over the subcell rows, one product each way giving the smeared
+   strains, the differences and the whole force (``rkfx.explicit.Stabilization``).
 
 Steps 2, 4 and 5 are compiled loops over the particles (in parallel); step 3 touches only
 the particles that initiate in this step.
@@ -197,7 +199,8 @@ class DamageForce:
 
     def __call__(self, d: np.ndarray) -> np.ndarray:
         f, op = self.field, self.op
-        e = op.strain(d)
+        stab = getattr(op, "stabilization", None)
+        e, diff = op.strains(d) if stab is not None else (op.strain(d), None)
         _equivalent_strain(e, self.c, self.nu_zz, f.allowed, f.damaged, self.kappa0, self._eq, self._effective,
                            self._crossing)
         f.clock[0] += self.dt
@@ -206,13 +209,10 @@ class DamageForce:
             self._initiate(new)
         _damage_stress(self._eq, self._effective, f.allowed, f.damaged, self.kappa0, f.kappa_c, f.kappa, f.damage,
                        self.stress)
-        force = op.force(self.stress)
-        stab = getattr(op, "stabilization", None)
-        if stab is not None:
-            e = op.subcell_strain(d)
-            _subcell_stress(e, self.c, stab.owner, f.damage, e)
-            force += op.subcell_force(e)
-        return force
+        if stab is None:
+            return op.force(self.stress)
+        _subcell_stress(diff, self.c, stab.owner, f.damage, diff)
+        return op.force(self.stress, diff)
 
     def _initiate(self, new: np.ndarray) -> None:
         """Fix n_L (major principal direction of C e, 4.22) and kappa_c (4.28) of the particles

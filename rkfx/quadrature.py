@@ -107,6 +107,27 @@ def smoothed_gradients(p: Particles, rk: RKApproximation, domains: NodalDomains,
     return SmoothedGradients(cell, evaluate(rk, p.x), diff)
 
 
+def subcell_gradients(rk: RKApproximation, domains: NodalDomains
+                      ) -> tuple[SparseRows, SparseRows, np.ndarray]:
+    """The smoothed gradients of eq. (3.55) over each cell, grad~N_I(x_L), and over each of
+    its subcells, grad~N_I(x_hat_C) (the subcell rows of eq. 3.56), from one evaluation of N
+    at the smoothing points.
+
+    Returns:
+        (cell rows, subcell rows, order): subcell row k belongs to subcell ``order[k]`` of
+        ``domains``; the rows are grouped by particle (stable sort of ``subcell_node``).
+    """
+    d = domains
+    at_points = evaluate(rk, d.smoothing_points)
+    cell = combine_rows(at_points, d.cell_ptr, d.cell_point,
+                        d.cell_normal_length / np.repeat(d.area, np.diff(d.cell_ptr))[:, None])
+    order = np.argsort(d.subcell_node, kind="stable")
+    ns = len(order)
+    sub = combine_rows(at_points, np.arange(0, 4 * ns + 1, 4), d.subcell_point[order].ravel(),
+                       (d.subcell_normal_length[order] / d.subcell_area[order, None, None]).reshape(-1, 2))
+    return cell, sub, order
+
+
 def scni(p: Particles, rk: RKApproximation, domains: NodalDomains,
          smoothed: SmoothedGradients | None = None) -> Quadrature:
     """SCNI: smoothed gradients at the nodes, weights A_L (eq. 3.55)."""

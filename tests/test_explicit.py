@@ -9,7 +9,7 @@ from rkfx.explicit import (CHECKPOINT, Constraint, ExplicitDynamics, constraint,
                            elastic_force, load_checkpoint, lumped_mass, max_frequency, run_explicit,
                            smeared_strain, stable_time_step)
 from rkfx.nodal_domains import nodal_domains
-from rkfx.operators import stiffness
+from rkfx.operators import stiffness, strain_matrix
 from rkfx.particles import structured
 from rkfx.quadrature import scni, smoothed_gradients
 from rkfx.shape_functions import evaluate, rk_approximation
@@ -31,6 +31,37 @@ def test_smeared_strain_operator_is_the_scni_stiffness():
     assert np.abs(f_int(d) - k @ d).max() <= 1e-12 * np.abs(k @ d).max()
     assert np.abs(op.strain(d).ravel() - op.B @ d).max() <= 1e-12 * np.abs(d).max() * 20
     assert np.abs(op.BT @ np.ones(3 * p.num_nodes) - op.B.T @ np.ones(3 * p.num_nodes)).max() == 0.0
+
+
+@pytest.mark.parametrize("cells", ["median-dual", "grid with a slit"])
+def test_mscni_operator_from_subcell_rows_is_the_mscni_stiffness(cells):
+    """One product with the subcell rows gives the cell strains, the MSCNI differences and,
+    transposed, the force of SCNI plus eq. (3.56), on both kinds of nodal domains."""
+    from rkfx.cracks import cracks
+    from rkfx.grid_cells import grid_domains
+    from rkfx.particles import graded
+    from rkfx.quadrature import mscni_stabilization
+    if cells == "median-dual":
+        p = structured(1.0, 0.7, 12, 9)
+        rk, dom = rk_approximation(p.x, p.spacing), nodal_domains(p)
+    else:
+        xs, ys = np.linspace(0.0, 1.0, 12), np.linspace(0.0, 0.75, 10)
+        p = graded(xs, ys)
+        slit = ((0.0, 0.375), (0.5, 0.375))
+        rk = rk_approximation(p.x, p.spacing, 1.75, cracks=cracks([np.array(slit)], [(False, True)]))
+        dom = grid_domains(xs, ys, [slit])
+    mat = ElasticMaterial(3.0, 0.25)
+    op = smeared_strain(p, rk, dom, eps_p=0.7)
+    d = np.random.default_rng(1).standard_normal(2 * p.num_nodes)
+    e, diff = op.strains(d)
+    assert np.abs(e.ravel() - op.B @ d).max() <= 1e-12 * np.abs(e).max()
+    stab = mscni_stabilization(p, rk, dom, eps_p=0.7)
+    order = np.argsort(dom.subcell_node, kind="stable")
+    reference = (strain_matrix(stab.gradients) @ d).reshape(-1, 3)[order]
+    assert np.abs(diff - reference).max() <= 1e-12 * np.abs(reference).max()
+    k = stiffness([scni(p, rk, dom), stab], mat.D())
+    f = elastic_force(op, mat.D())(d)
+    assert np.abs(f - k @ d).max() <= 1e-11 * np.abs(k @ d).max()
 
 
 def test_lumped_masses_carry_the_total_mass():
