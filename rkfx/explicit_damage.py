@@ -136,6 +136,8 @@ class DamageField:
         damaged: Whether the particle has initiated, ``(n,)`` bool.
         allowed: Whether it may initiate (seeds, candidates, damaged), ``(n,)`` bool.
         initiation_time: Time of initiation [s] (NaN before), ``(n,)``.
+        parent: The particle whose initiation made this one a candidate (-1: none, e.g. the
+            seeds), ``(n,)`` int64 (``rkfx.crack_tracking``: growth direction).
         clock: Time of the last force evaluation [s], shape ``(1,)`` (starts at -dt, so the
             evaluation of the initial state reads t = 0; checkpointed with the rest).
     """
@@ -148,13 +150,14 @@ class DamageField:
     damaged: np.ndarray
     allowed: np.ndarray
     initiation_time: np.ndarray
+    parent: np.ndarray
     clock: np.ndarray
 
     @property
     def arrays(self) -> dict[str, np.ndarray]:
         """The arrays by name (for ``run_explicit(extra_state=...)``: checkpointed, restored in place)."""
         return {k: getattr(self, k) for k in ("kappa", "damage", "normal", "kappa_c", "chord", "damaged",
-                                              "allowed", "initiation_time", "clock")}
+                                              "allowed", "initiation_time", "parent", "clock")}
 
     def dissipated(self, model: DamageModel) -> float:
         """Energy dissipated so far, sum_L V_L phi(kappa_L) [J per unit thickness] (``rkfx.damage``)."""
@@ -172,7 +175,7 @@ def damage_field(model: DamageModel, track: Tracking | None = None, dt: float = 
     kc = np.full(n, np.nan) if model.regularized else model.kappa_c.copy()
     allowed = np.ones(n, bool) if track is None or not track.enabled else track.seeds.copy()
     return DamageField(np.zeros(n), np.zeros(n), np.zeros((n, 2)), kc, np.full(n, np.nan), np.zeros(n, bool),
-                       allowed, np.full(n, np.nan), np.array([-float(dt)]))
+                       allowed, np.full(n, np.nan), np.full(n, -1, np.int64), np.array([-float(dt)]))
 
 
 class DamageForce:
@@ -228,7 +231,10 @@ class DamageForce:
         f.damaged[new] = True
         f.initiation_time[new] = f.clock[0]
         if self.track is not None and self.track.enabled:
-            f.allowed[self.track.candidates(new, normal)] = True
+            cand, by = self.track.candidates(new, normal, f.parent)
+            fresh = ~f.allowed[cand]
+            f.parent[cand[fresh]] = by[fresh]
+            f.allowed[cand] = True
 
 
 # --------------------------------------------------------------------------- runs

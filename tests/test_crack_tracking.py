@@ -18,7 +18,8 @@ def test_candidates_lie_along_the_crack_within_the_tolerance(square):
     h = 0.1
     track = tracking(p.x, p.spacing, 0.3, radius=3.5)
     centre = int(np.argmin(np.linalg.norm(p.x - 0.5, axis=1)))
-    cand = track.candidates(np.array([centre]), np.array([[0.0, 1.0]]))  # horizontal crack
+    cand, by = track.candidates(np.array([centre]), np.array([[0.0, 1.0]]))  # horizontal crack
+    assert np.all(by == centre)
     d = p.x[cand] - p.x[centre]
     assert centre not in cand
     assert np.all(np.abs(d[:, 1]) / np.linalg.norm(d, axis=1) < 0.3)
@@ -35,8 +36,27 @@ def test_a_narrow_neighbourhood_follows_only_lattice_directions():
     centre = 60
     assert len(track.indices[track.indptr[centre]:track.indptr[centre + 1]]) == 8
     t = np.radians(-20.0)
-    assert track.candidates(np.array([centre]), np.array([[np.cos(t), np.sin(t)]])).size == 0
-    assert sorted(track.candidates(np.array([centre]), np.array([[1.0, 0.0]]))) == [49, 71]
+    assert track.candidates(np.array([centre]), np.array([[np.cos(t), np.sin(t)]]))[0].size == 0
+    assert sorted(track.candidates(np.array([centre]), np.array([[1.0, 0.0]]))[0]) == [49, 71]
+
+
+def test_candidates_lie_ahead_of_the_parent():
+    """A particle made a candidate by its left neighbour admits only the neighbours to its
+    right (and level with it); without a parent, or with ``forward`` off, both sides."""
+    p = structured(1.0, 1.0, 11, 11)
+    centre, left = 60, 59
+    parents = np.full(p.num_nodes, -1)
+    parents[centre] = left
+    horizontal = np.array([[0.0, 1.0]])
+    for forward, expect in ((True, [1, 2, 3]), (False, [-3, -2, -1, 1, 2, 3])):
+        track = tracking(p.x, p.spacing, 0.3, radius=3.5, forward=forward)
+        cand, by = track.candidates(np.array([centre]), horizontal, parents)
+        assert sorted(np.round((p.x[cand, 0] - p.x[centre, 0]) / 0.1).astype(int)) == expect
+    track = tracking(p.x, p.spacing, 0.3, radius=3.5)
+    assert len(track.candidates(np.array([centre]), horizontal, np.full(p.num_nodes, -1))[0]) == 6
+    # Two initiating particles: each candidate records the first that admits it.
+    cand, by = track.candidates(np.array([centre, 61]), np.array([[0.0, 1.0], [0.0, 1.0]]), parents)
+    assert by[cand == 62][0] == centre and by[cand == 60][0] == 61
 
 
 def test_seeds_and_switch():

@@ -66,8 +66,11 @@ def test_only_allowed_particles_initiate(square):
     # Its horizontal neighbours (1.5 h: left and right, not the diagonals) are candidates now.
     allowed = np.flatnonzero(field.allowed)
     assert sorted(np.round((p.x[allowed] - p.x[seed]) / 0.1).astype(int).tolist()) == [[-1, 0], [0, 0], [1, 0]]
+    assert field.parent[allowed].tolist() == [seed, -1, seed]
     force(d)
     assert field.damaged.sum() == 3
+    # The new crack tips grow away from the seed: the next candidates lie outside, not back.
+    assert sorted(np.round((p.x[field.allowed] - p.x[seed]) / 0.1).astype(int)[:, 0].tolist()) == [-2, -1, 0, 1, 2]
     # Without tracking every particle past its threshold initiates at once.
     free = damage_field(model)
     DamageForce(op, model, free)(d)
@@ -79,7 +82,7 @@ def test_history_arrays_are_named_views(square):
     field = damage_field(model, dt=2.0)
     arrays = field.arrays
     assert set(arrays) == {"kappa", "damage", "normal", "kappa_c", "chord", "damaged", "allowed",
-                           "initiation_time", "clock"}
+                           "initiation_time", "parent", "clock"}
     arrays["kappa"][0] = 7.0
     assert field.kappa[0] == 7.0
     assert field.clock[0] == -2.0  # the evaluation of the initial state reads t = 0

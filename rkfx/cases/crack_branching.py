@@ -42,7 +42,7 @@ balance| / max energy). A summary run per study maps h to branches and final dis
 and gives ``dissipation_change_fine``, |W_d(finest) - W_d(second finest)| / W_d(finest).
 
 Parameters (``--set NAME=VALUE``, SI units): E, nu, rho, ft, GF, sigma, plane, t_end, tol, h,
-unregularized_h, support_factor, courant, radius, eps_p. Long runs: ``--checkpoint-every N`` writes
+unregularized_h, support_factor, courant, radius, forward, eps_p. Long runs: ``--checkpoint-every N`` writes
 each model's state every N steps to OUT/checkpoints/, and ``--resume DIR`` continues an
 interrupted invocation (finished models are read back).
 
@@ -83,6 +83,7 @@ PARAMS = {
     "support_factor": Param(1.75, "RK support radius / nodal spacing (>= 1.6: see rkfx.cases.kalthoff)"),
     "courant": Param(0.5, "dt = courant * h / c_d"),
     "radius": Param(3.5, "tracking neighbourhood radius / nodal spacing"),
+    "forward": Param(True, "tracking: candidates only ahead of their particle (false: (4.22) both ways)"),
     "eps_p": Param(1.0, "weight of the MSCNI stabilization (0: plain SCNI)"),
 }
 QUICK = {"h": [1.6e-3, 8e-4], "unregularized_h": [1.6e-3, 8e-4]}
@@ -137,7 +138,7 @@ def _rkpm(label, study, h, material, prm, regularized=True, kappa_c=None, **io) 
     pl = dyn.plate(xs, ys, [((0.0, A2), (A1, A2))], [(False, True)], material, prm["rho"], prm["support_factor"],
                    prm["courant"], prm["eps_p"])
     seeds = np.linalg.norm(pl.p.x - np.array([A1, A2]), axis=1) < 0.75 * pl.h
-    track = tracking(pl.p.x, pl.p.spacing, prm["tol"], seeds, prm["radius"])
+    track = tracking(pl.p.x, pl.p.spacing, prm["tol"], seeds, prm["radius"], forward=prm["forward"])
     model = dyn.damage_model(pl, material, regularized, kappa_c)
     f = traction_force(pl, prm["sigma"])
     r = dyn.simulate(label, pl, model, track, [], prm["t_end"], external_force=lambda t: f, **io)
@@ -195,13 +196,14 @@ def _summary(study: str, runs: Sequence[Run]) -> Run:
 
 def run(*, methods: Sequence[str] = ("rkpm",), E=3.2e10, nu=0.2, rho=2450.0, ft=2.72e6, GF=3.0, sigma=1.0e6,
         plane="strain", t_end=80e-6, tol=0.5, h=(8e-4, 4e-4, 2e-4), unregularized_h=(8e-4, 4e-4, 2e-4),
-        support_factor=1.75, courant=0.5, radius=3.5, eps_p=1.0, checkpoint_every=0, work_dir=None,
+        support_factor=1.75, courant=0.5, radius=3.5, forward=True, eps_p=1.0, checkpoint_every=0, work_dir=None,
         resume=None) -> Results:
     """The damage particle method, regularized and with a constant kappa_c, at each spacing."""
     hs, unreg = [float(v) for v in h], [float(v) for v in unregularized_h]
     material = _check(E, nu, rho, ft, GF, sigma, plane, t_end, tol, hs + unreg, support_factor, courant, radius)
     prm = dict(E=E, nu=nu, rho=rho, ft=ft, GF=GF, sigma=sigma, plane=plane, t_end=t_end, tol=tol, h=hs,
-               unregularized_h=unreg, support_factor=support_factor, courant=courant, radius=radius, eps_p=eps_p)
+               unregularized_h=unreg, support_factor=support_factor, courant=courant, radius=radius, forward=forward,
+               eps_p=eps_p)
     io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume}
     xs, ys = grid(max(hs + unreg) if hs + unreg else 8e-4)
     h0 = float(max(np.diff(xs).max(), np.diff(ys).max()))
