@@ -75,7 +75,8 @@ def main(argv=None):
     print(f"one step: strains {1e3 * t_strain:.1f} ms, force {1e3 * t_force:.1f} ms, damage force in all "
           f"{1e3 * t_all:.1f} ms (kernels and tracking {1e3 * (t_all - t_strain - t_force):.1f} ms), "
           f"rest of the step {1e3 * (per_step - t_all):.1f} ms")
-    print(f"dissipated {run.history[-1, 1]:.0f} J/m, failed particles {int((run.damage >= 0.9).sum())}, "
+    cracked = int((run.opening >= 0.5).sum())
+    print(f"dissipated {run.history[-1, 1]:.0f} J/m, cracked particles (w / w_c >= 0.5) {cracked}, "
           f"energy balance error {run.energy_error:.1e}")
     print(f"{n} particles: {run.wall_time_s + setup:.1f} s for {1e6 * args.t_end:.0f} us")
 

@@ -205,6 +205,24 @@ def dissipation_density(kappa: np.ndarray, kappa0: np.ndarray | float, kappa_c: 
     return np.where(kappa > kappa0, 0.5 * kappa0 * (E * np.minimum(kappa, kappa_c) - sigma), 0.0)
 
 
+def crack_opening(kappa: np.ndarray, kappa0: np.ndarray | float, kappa_c: np.ndarray | float) -> np.ndarray:
+    """Crack opening over the critical opening, w / w_c = min(D kappa / kappa_c, 1), per point.
+
+    The inelastic strain D kappa smeared over the band of the point, over the band's critical
+    strain kappa_c; it equals the fraction phi(kappa) / g_L of the point's fracture energy
+    spent. Use it to see cracks: D itself says little once kappa_c >> kappa0 (fine
+    regularized models), as D = 0.5 already at kappa ~ 2 kappa0, where the stress has barely
+    softened. 0 below kappa0 (and where kappa_c is NaN, i.e. before initiation), 1 once failed.
+    """
+    kappa, kappa0, kappa_c = np.broadcast_arrays(*(np.asarray(a, float) for a in (kappa, kappa0, kappa_c)))
+    w = np.zeros(kappa.shape)
+    on = (kappa > kappa0) & np.isfinite(kappa_c)
+    w[on] = 1.0  # also where kappa_c <= kappa0: perfectly brittle, failed at once
+    soft = on & (kappa < kappa_c)
+    w[soft] = damage(kappa[soft], kappa0[soft], kappa_c[soft]) * kappa[soft] / kappa_c[soft]
+    return w
+
+
 def critical_strain(material: DamageMaterial, chord: np.ndarray, volume: np.ndarray) -> np.ndarray:
     """Regularized kappa_c = (G_F / f_t) A_L / V_L (4.28), shape like ``chord``.
 

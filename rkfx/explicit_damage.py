@@ -50,7 +50,7 @@ import numba
 import numpy as np
 
 from .crack_tracking import Tracking
-from .damage import DamageModel, chord_lengths, critical_strain, dissipation_density
+from .damage import DamageModel, chord_lengths, crack_opening, critical_strain, dissipation_density
 from .errors import InputError
 from .explicit import Constraint, ExplicitDynamics, run_explicit
 
@@ -164,8 +164,17 @@ class DamageField:
         i = np.flatnonzero(self.damaged)
         if i.size == 0:
             return 0.0
-        return float(np.sum(model.volume[i] * dissipation_density(self.kappa[i], model.kappa0[i], self.kappa_c[i],
-                                                                  model.material.E)))
+        return float(np.sum(self._dissipation(model, i)))
+
+    def dissipation(self, model: DamageModel) -> np.ndarray:
+        """Energy dissipated so far per point, V_L phi(kappa_L) [J per unit thickness], ``(n,)``."""
+        out = np.zeros(len(self.kappa))
+        i = np.flatnonzero(self.damaged)
+        out[i] = self._dissipation(model, i)
+        return out
+
+    def _dissipation(self, model: DamageModel, i: np.ndarray) -> np.ndarray:
+        return model.volume[i] * dissipation_density(self.kappa[i], model.kappa0[i], self.kappa_c[i], model.material.E)
 
 
 def damage_field(model: DamageModel, track: Tracking | None = None, dt: float = 0.0) -> DamageField:
@@ -250,6 +259,9 @@ class DamageRun:
             internal work, external work [J/m]), shape ``(k, 6)`` (columns ``HISTORY``); the
             external work includes that of the prescribed motions (e.g. an impact velocity).
         damage, kappa, normal, initiation_time: Final damage history per particle.
+        opening: Final crack opening over the critical opening, w / w_c per particle
+            (``rkfx.damage.crack_opening``: the fraction of its fracture energy spent).
+        dissipation: Final dissipated energy per particle, V_L phi(kappa_L) [J/m].
         displacement, velocity: Final coefficients [m] and velocities [m/s], shape ``(2 n,)``.
         steps, dt: Time steps taken and their size [s].
         wall_time_s: Wall time of the time stepping [s] (summed over resumed pieces).
@@ -263,6 +275,8 @@ class DamageRun:
     kappa: np.ndarray
     normal: np.ndarray
     initiation_time: np.ndarray
+    opening: np.ndarray
+    dissipation: np.ndarray
     displacement: np.ndarray
     velocity: np.ndarray
     steps: int
@@ -278,7 +292,9 @@ class DamageRun:
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_suffix(".tmp.npz")
         np.savez(tmp, history=self.history, damage=self.damage, kappa=self.kappa, normal=self.normal,
-                 initiation_time=self.initiation_time, displacement=self.displacement, velocity=self.velocity,
+                 initiation_time=self.initiation_time, opening=self.opening, dissipation=self.dissipation,
+                 displacement=self.displacement,
+                 velocity=self.velocity,
                  steps=self.steps, dt=self.dt, wall_time_s=self.wall_time_s,
                  energy_error=self.energy_error, label=self.label)
         tmp.replace(path)
@@ -286,8 +302,11 @@ class DamageRun:
     @classmethod
     def load(cls, path: Path) -> "DamageRun":
         with np.load(path) as z:
+            if "dissipation" not in z:
+                raise InputError(f"{path} predates the per-particle crack outputs; run again without --resume")
             return cls(str(z["label"]), z["history"], z["damage"], z["kappa"], z["normal"], z["initiation_time"],
-                       z["displacement"], z["velocity"], int(z["steps"]), float(z["dt"]), float(z["wall_time_s"]), float(z["energy_error"]))
+                       z["opening"], z["dissipation"], z["displacement"], z["velocity"], int(z["steps"]),
+                       float(z["dt"]), float(z["wall_time_s"]), float(z["energy_error"]))
 
 
 def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, model: DamageModel,
@@ -345,8 +364,9 @@ def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, mode
     if slot[0] == 0 or history[slot[0] - 1, 0] < steps * dt * (1 - 1e-12):
         record(res.state)
     run = DamageRun(label, history[:slot[0]].copy(), field.damage.copy(), field.kappa.copy(), field.normal.copy(),
-                      field.initiation_time.copy(), res.state.d.copy(), res.state.v.copy(), steps, dt, elapsed, res.relative_energy_error(),
-                      res.resumed_from)
+                    field.initiation_time.copy(), crack_opening(field.kappa, model.kappa0, field.kappa_c),
+                    field.dissipation(model), res.state.d.copy(), res.state.v.copy(), steps, dt, elapsed,
+                    res.relative_energy_error(), res.resumed_from)
     if checkpoint_dir is not None:
         run.save(checkpoint_dir / "result.npz")
     return run

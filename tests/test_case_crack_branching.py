@@ -106,7 +106,7 @@ def test_cli_writes_metrics_notes_fem_and_rejects_bad_input(tmp_path, capsys):
     assert {"time_us", "dissipated", "tip_x"} <= set(run["series"])
     summ = next(r for r in data["runs"] if r["info"].get("of") == "rkpm-dpm")
     assert "dissipation_change_fine" in summ["errors"] and set(summ["series"]["branches"]) == {"0.0016"}
-    for f in ("damage.png", "damage_unregularized.png", "dissipation.png"):
+    for f in ("cracks.png", "damage.png", "damage_unregularized.png", "dissipation.png"):
         assert (out / f).is_file()
     capsys.readouterr()
     # No finite element baseline here: a one-line note and no runs, not a crash.

@@ -94,6 +94,18 @@ def uniaxial_model(kappa_c=2e-3, volume=(2.0,)):
     return dm.damage_model(MAT, np.asarray(volume, float), kappa_c=kappa_c, regularized=False)
 
 
+def test_crack_opening_is_the_spent_fraction_of_the_fracture_energy():
+    """w / w_c = D kappa / kappa_c = phi(kappa) / g_L: small while D is already large."""
+    k0, kc = MAT.kappa0, 65 * MAT.kappa0  # kappa_c / kappa0 of the 0.2 mm branching model
+    kappa = np.array([0.5 * k0, 2 * k0, 10 * k0, 0.6 * kc, kc, 2 * kc])
+    w = dm.crack_opening(kappa, k0, kc)
+    assert np.allclose(w, dm.dissipation_density(kappa, k0, kc, MAT.E) / (0.5 * MAT.ft * kc), rtol=1e-12)
+    assert w[0] == 0.0 and w[-2] == w[-1] == 1.0
+    assert dm.damage(10 * k0, k0, kc) > 0.9 and w[2] < 0.15  # D says failed, the band has barely opened
+    # Before initiation (kappa_c NaN) and when perfectly brittle (kappa_c <= kappa0).
+    assert dm.crack_opening(2 * k0, k0, np.nan) == 0.0 and dm.crack_opening(2 * k0, k0, 0.5 * k0) == 1.0
+
+
 def test_irreversibility_under_unloading_and_reloading():
     model = uniaxial_model()
     k0 = MAT.kappa0

@@ -46,6 +46,7 @@ def test_stress_and_damage_match_the_reference_update(square):
     np.testing.assert_allclose(field.kappa_c[field.damaged], state.kappa_c[state.damaged], rtol=1e-12)
     np.testing.assert_allclose(np.abs(field.normal[field.damaged]), np.abs(state.normal[state.damaged]), atol=1e-12)
     assert np.isclose(field.dissipated(model), state.dissipated.sum(), rtol=1e-10)
+    np.testing.assert_allclose(field.dissipation(model), state.dissipated, rtol=1e-10, atol=1e-14)
 
 
 def test_only_allowed_particles_initiate(square):

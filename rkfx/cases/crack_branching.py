@@ -34,11 +34,13 @@ There is no finite element baseline for this case: ``--method fem`` runs nothing
 one-line note) and ``--method both`` runs the RKPM studies.
 
 Metrics per run: ``branches``, the number of major branches (``count_branches`` across every
-grid column in x = 0.08-0.095 m; the most frequent nonzero count, ties to the larger), ``branch_x`` [m], the
-smallest x > a1 where a column is crossed by two or more separate failed bands (where the
-crack first splits; NaN if it never does), ``tip_x`` [m], the largest x of the particles
-with D >= 0.9, ``dissipated_end`` [J/m] with its history, and ``energy_error`` (max |energy
-balance| / max energy). A summary run per study maps h to branches and final dissipation
+grid column in x = 0.08-0.095 m; the most frequent nonzero count, ties to the larger),
+``branch_x`` [m], the smallest x > a1 where a column is crossed by two or more separate
+cracks (where the crack first splits; NaN if it never does), ``tip_x`` [m], the largest x
+of the cracked particles (crack opening w / w_c >= 0.5, ``_dynamic_fracture``),
+``dissipated_end`` [J/m] with its history and the share spent in the cracked particles
+(``dissipated_in_cracks``), and ``energy_error`` (max |energy balance| / max
+energy). A summary run per study maps h to branches and final dissipation
 and gives ``dissipation_change_fine``, |W_d(finest) - W_d(second finest)| / W_d(finest).
 
 Parameters (``--set NAME=VALUE``, SI units): E, nu, rho, ft, GF, sigma, plane, t_end, tol, h,
@@ -145,13 +147,13 @@ def _rkpm(label, study, h, material, prm, regularized=True, kappa_c=None, **io) 
     return _run_record(r, study, h, pl, 2 * pl.p.num_nodes)
 
 
-def branch_metrics(damage: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> tuple[int, float, np.ndarray]:
-    """(branches, branch_x, counts): the most frequent nonzero number of failed bands across the
+def branch_metrics(opening: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> tuple[int, float, np.ndarray]:
+    """(branches, branch_x, counts): the most frequent nonzero number of cracks across the
     columns in ``BRANCH_WINDOW`` (0 if none), the smallest column x > a1 crossed by two or more
     bands (NaN if none), and the band count of every column x > a1."""
     nx, ny = len(xs), len(ys)
     right = np.flatnonzero(xs > A1)
-    counts = dyn.count_branches(damage, nx, ny, right)
+    counts = dyn.count_branches(opening, nx, ny, right)
     window = (xs[right] >= BRANCH_WINDOW[0] - 1e-12) & (xs[right] <= BRANCH_WINDOW[1] + 1e-12)
     nonzero = [int(c) for c in counts[window] if c > 0]
     # Mode; a tie goes to the larger count.
@@ -163,15 +165,16 @@ def branch_metrics(damage: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> tuple[
 
 def _run_record(r: DamageRun, study, h, pl: dyn.Plate, dofs) -> Run:
     x = pl.p.x
-    branches, branch_x, counts = branch_metrics(r.damage, pl.xs, pl.ys)
-    failed = r.damage >= 0.9
-    tip_x = float(x[failed, 0].max()) if failed.any() else float("nan")
+    branches, branch_x, counts = branch_metrics(r.opening, pl.xs, pl.ys)
+    cracked = r.opening >= dyn.CRACKED
+    tip_x = float(x[cracked, 0].max()) if cracked.any() else float("nan")
     hist = r.history
-    # Crack tip history: the largest x of the particles (finally failed) initiated by each sample time.
-    t_init = np.where(failed, r.initiation_time, np.inf)
+    # Crack tip history: the largest x of the particles (finally cracked) initiated by each sample time.
+    t_init = np.where(cracked, r.initiation_time, np.inf)
     tip_hist = np.array([x[s, 0].max() if (s := t_init <= t + 0.5 * r.dt).any() else np.nan for t in hist[:, 0]])
     series = {**dyn.run_series(r), "tip_x": tip_hist, "column_x": pl.xs[pl.xs > A1], "column_bands": counts}
     errors = {"branches": branches, "branch_x": branch_x, "tip_x": tip_x, "dissipated_end": float(hist[-1, 1]),
+              "dissipated_in_cracks": dyn.crack_share(r),
               "energy_error": r.energy_error}
     info = {"study": study, "h_nominal": h, "nx": len(pl.xs), "ny": len(pl.ys), "h": pl.h, "steps": r.steps,
             "dt": r.dt}
@@ -226,8 +229,8 @@ def run(*, methods: Sequence[str] = ("rkpm",), E=3.2e10, nu=0.2, rho=2450.0, ft=
 # --------------------------------------------------------------------------- figures
 
 
-def _damage_map(ax, r: Run):
-    m = dyn.damage_map(ax, r.series, r.info["nx"], r.info["ny"], LX, LY)
+def _damage_map(ax, r: Run, key: str = "damaged_D"):
+    m = dyn.damage_map(ax, r.series, r.info["nx"], r.info["ny"], LX, LY, key)
     ax.plot([0, A1], [A2, A2], color="tab:blue", lw=2)
     for xb in BRANCH_WINDOW:
         ax.axvline(xb, color="tab:green", lw=0.8, ls=":")
@@ -255,18 +258,21 @@ def plot(results: Results, out: Path) -> list[Path]:
     out = Path(out)
     files = []
     t_us = 1e6 * results.params["t_end"]
-    for study, fname, head in (("rkpm-dpm", "damage", "damage particle method (regularized)"),
-                               ("rkpm-dpm-unregularized", "damage_unregularized", "constant $\\kappa_c$")):
+    for study, fname, head, key in (
+            ("rkpm-dpm", "cracks", "damage particle method (regularized)", "damaged_w"),
+            ("rkpm-dpm", "damage", "damage particle method (regularized)", "damaged_D"),
+            ("rkpm-dpm-unregularized", "damage_unregularized", "constant $\\kappa_c$", "damaged_D")):
         runs = sorted((r for r in results.runs if r.info.get("study") == study), key=lambda r: -r.info["h"])
         if not runs:
             continue
+        what = ("crack opening", "crack opening $w / w_c$") if key == "damaged_w" else ("damage", "damage D")
         fig, axes = plt.subplots(len(runs), 1, figsize=(7.6, 2.5 * len(runs) + 0.7), squeeze=False,
                                  layout="constrained")
         for ax, r in zip(axes[:, 0], runs):
-            m = _damage_map(ax, r)
+            m = _damage_map(ax, r, key)
             ax.set_title(_title(r), fontsize=8.5)
-        fig.colorbar(m, ax=list(axes[:, 0]), label="damage D", shrink=0.9 if len(runs) > 1 else 0.7)
-        fig.suptitle(f"crack branching, {head}: damage at t = {t_us:.0f} µs\n(green: columns where branches are "
+        fig.colorbar(m, ax=list(axes[:, 0]), label=what[1], shrink=0.9 if len(runs) > 1 else 0.7)
+        fig.suptitle(f"crack branching, {head}: {what[0]} at t = {t_us:.0f} µs\n(green: columns where branches are "
                      "counted; cyan: first split)", fontsize=10)
         files.append(_cli.save(fig, out / f"{fname}.png"))
     path = dyn.plot_dissipation(
