@@ -1,6 +1,10 @@
-"""Explicit-dynamics crack-band finite elements for Kalthoff's impact problem (seed 4.3.2).
+"""Explicit-dynamics crack-band finite elements for the slit plates of seed 4.3.2 and 4.3.3.
 
-The problem (Kalthoff and Winkler's edge-cracked plate, upper half by symmetry; plane strain):
+Two problems on a plate with an edge slit: Kalthoff's impact (``kalthoff_crack_band``) and
+the crack-branching plate (``branching_crack_band``: [0, 0.1] x [0, 0.04] m, slit along
+y = 0.02 m to x = 0.05 m, a step traction sigma on the top and bottom edges as consistent
+nodal forces ``edge_traction``, no supports). Kalthoff's problem (Kalthoff and Winkler's
+edge-cracked plate, upper half by symmetry; plane strain):
 
     domain        [0, side] x [0, side] (0.1 m x 0.1 m)
     slit          y = a2 (0.025 m) for 0 <= x <= a1 (0.05 m): two traction-free faces
@@ -9,7 +13,7 @@ The problem (Kalthoff and Winkler's edge-cracked plate, upper half by symmetry; 
                   face end at y = a2^-): u_x velocity v0 (16.5 m/s) from t = 0, u_y free
     elsewhere     traction free
 
-Mesh. gmsh (OpenCASCADE kernel, headless) meshes the square with the slit line embedded
+Mesh. gmsh (OpenCASCADE kernel, headless) meshes the rectangle with the slit line embedded
 (``fragment``) at a uniform target size h; gmsh's ``Crack`` plugin then duplicates the nodes
 of the slit (both ends stay single except the mouth at x = 0, which lies on the outer
 boundary and is opened through ``OpenBoundaryPhysicalGroup``), so the two faces share only
@@ -35,12 +39,13 @@ no crack tracking. ``regularized=False`` uses one given kappa_c for every cell i
 mesh-dependent, unregularized comparison).
 
 Time integration: central differences with the lumped mass (``rkfx.explicit.run_explicit``),
-essential conditions as rows of the identity (``Constraint``): u_y = 0 on y = 0 and the
-impact velocity on the impact edge. The internal-force callable updates the damage history
-in place (it is called once per step with the new displacement); the history arrays are the
-run's ``extra_state``, so checkpoints and ``resume`` restore them. The dissipated energy is
-accumulated per step from the exact dissipation density (``dissipation_density``) of the
-cells whose history grew, and is part of the extra state too.
+essential conditions as rows of the identity (``Constraint``): for Kalthoff u_y = 0 on y = 0
+and the impact velocity on the impact edge; the branching plate has none. The internal-force
+callable updates the damage history in place (it is called once per step with the new
+displacement); the history arrays are the run's ``extra_state``, so checkpoints and
+``resume`` restore them. The dissipated energy is accumulated per step from the exact
+dissipation density (``dissipation_density``) of the cells whose history grew, and is part
+of the extra state too.
 
 Stable step: dt = courant * min_e(a_e) / c_d with a_e the smallest altitude of cell e and
 c_d = sqrt((lambda + 2 mu) / rho).
@@ -53,6 +58,7 @@ Units: SI (m, s, kg, Pa, N/m); energies are per unit thickness [J/m].
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -82,6 +88,8 @@ __all__ = [
     "FemOperators",
     "cracked_plate_mesh",
     "fem_operators",
+    "branching_crack_band",
+    "edge_traction",
     "kalthoff_crack_band",
     "slit_sides",
     "stable_time_step",
@@ -155,39 +163,43 @@ class CrackedPlateMesh:
         return self.vertices.mean(axis=1)
 
 
-def _check_geometry(h: float, side: float, a1: float, a2: float) -> None:
-    for name, val in (("side", side), ("a1", a1), ("a2", a2)):
+def _check_geometry(h: float, width: float, height: float, a1: float, a2: float) -> None:
+    for name, val in (("width", width), ("height", height), ("a1", a1), ("a2", a2)):
         if not (np.isfinite(val) and val > 0):
             raise InputError(f"{name} = {val!r} must be positive and finite (lengths in m)")
-    if not (a1 < side and a2 < side):
-        raise InputError(f"slit end (a1, a2) = ({a1:g}, {a2:g}) must lie inside the plate of side {side:g}")
+    if not (a1 < width and a2 < height):
+        raise InputError(f"slit end (a1, a2) = ({a1:g}, {a2:g}) must lie inside the plate "
+                         f"{width:g} x {height:g} m")
     if not (np.isfinite(h) and h > 0):
         raise InputError(f"element size h = {h!r} must be positive and finite (e.g. h=1e-3 m)")
-    coarse = 0.5 * min(a1, a2, side - a1, side - a2)
+    coarse = 0.5 * min(a1, a2, width - a1, height - a2)
     if h > coarse:
         raise InputError(f"element size h = {h:g} m is too coarse for the slit geometry; "
                          f"use h <= {coarse:g} m (two elements across its shortest distance to an edge)")
 
 
-def cracked_plate_mesh(h: float, *, side: float = 0.1, a1: float = 0.05, a2: float = 0.025) -> CrackedPlateMesh:
-    """Mesh [0, side]^2 with a slit along y = a2, 0 <= x <= a1, whose faces share only the tip.
+def cracked_plate_mesh(h: float, *, width: float = 0.1, height: float = 0.1, a1: float = 0.05,
+                       a2: float = 0.025) -> CrackedPlateMesh:
+    """Mesh [0, width] x [0, height] with a slit along y = a2, 0 <= x <= a1, whose faces share
+    only the tip.
 
     Args:
         h: Uniform target element size [m].
-        side: Plate side [m].
+        width, height: Plate size [m].
         a1: Slit length from x = 0 (x of the tip) [m].
         a2: Height of the slit [m].
     """
-    _check_geometry(h, side, a1, a2)
+    _check_geometry(h, width, height, a1, a2)
+    side = max(width, height)
     started = gmsh.isInitialized()
     if not started:
         gmsh.initialize(interruptible=False)
     gmsh.option.setNumber("General.Terminal", 0)
     try:
-        gmsh.model.add("kalthoff_slit")
+        gmsh.model.add("slit_plate")
         try:
             occ = gmsh.model.occ
-            square = occ.addRectangle(0.0, 0.0, 0.0, side, side)
+            square = occ.addRectangle(0.0, 0.0, 0.0, width, height)
             slit = occ.addLine(occ.addPoint(0.0, a2, 0.0), occ.addPoint(a1, a2, 0.0))
             occ.fragment([(2, square)], [(1, slit)])
             occ.synchronize()
@@ -337,7 +349,7 @@ class CellStrain:
 
 @dataclass
 class DynamicCrackBandResult:
-    """A crack-band run of Kalthoff's problem.
+    """A crack-band run of a slit plate (Kalthoff's or the branching plate).
 
     Attributes:
         num_nodes, num_cells: Mesh size (slit nodes counted twice).
@@ -379,6 +391,64 @@ def _identity_rows(dofs: np.ndarray, n2: int) -> sp.csr_matrix:
     return sp.csr_matrix((np.ones(k), (np.arange(k), dofs)), shape=(k, n2))
 
 
+def _on_root(comm: MPI.Comm, run: Callable[[], DynamicCrackBandResult]) -> DynamicCrackBandResult:
+    """``run()`` on rank 0 of ``comm`` (on ``MPI.COMM_SELF``), its result (or error) on every rank."""
+    if comm.size == 1:
+        return run()
+    result, error = None, None
+    if comm.rank == 0:
+        try:
+            result = run()
+        except Exception as exc:  # re-raised on every rank
+            error = exc
+    result, error = comm.bcast((result, error), root=0)
+    if error is not None:
+        raise error
+    return result
+
+
+def _check_run(material: dm.DamageMaterial, rho: float, t_end: float, samples: int, regularized: bool,
+               kappa_c: float | None) -> None:
+    if not (np.isfinite(rho) and rho > 0):
+        raise InputError(f"density rho = {rho!r} must be positive (kg/m^3, e.g. rho=8000)")
+    if not (np.isfinite(t_end) and t_end > 0):
+        raise InputError(f"t_end = {t_end!r} must be positive (seconds, e.g. t_end=80e-6)")
+    if int(samples) != samples or samples < 1:
+        raise InputError(f"samples = {samples!r} must be a positive integer")
+    if regularized:
+        if kappa_c is not None:
+            raise InputError("kappa_c is only used with regularized=False; drop it or set regularized=False")
+    elif kappa_c is None or not (np.isfinite(kappa_c) and kappa_c > material.kappa0):
+        raise InputError(f"regularized=False needs kappa_c > kappa0 = f_t / E = {material.kappa0:.4g}; "
+                         f"got kappa_c = {kappa_c!r}")
+
+
+def _crack_band(m: CrackedPlateMesh, material: dm.DamageMaterial, rho: float, t_end: float, regularized: bool,
+                kappa_c: float | None, courant: float, samples: int, label: str, conditions, io: dict,
+                wall: float) -> DynamicCrackBandResult:
+    """The explicit crack-band run on the mesh ``m``; ``conditions(m, ops) -> (constraints,
+    external_force)`` sets up the problem's loads."""
+    if regularized:
+        # the band width area / chord stays below the longest side
+        h_max = 2.0 * material.E * material.GF / material.ft**2
+        longest = np.linalg.norm(np.roll(m.vertices, -1, axis=1) - m.vertices, axis=2).max()
+        if longest >= h_max:
+            raise InputError(f"band too wide: elements up to {longest:.3g} m long may have h_e > 2 E G_F / f_t^2 "
+                             f"= {h_max:.3g} m, where kappa_c <= kappa0 (snap-back); use h < {h_max / 1.5:.3g} m")
+    ops = fem_operators(m, rho)
+    dt = stable_time_step(m, material.E, material.nu, rho, courant)
+    model = dm.damage_model(material, ops.area, geometry=triangle_geometry(m.vertices) if regularized else None,
+                            kappa_c=kappa_c, regularized=regularized, band_factor=2.0)
+    constraints, external_force = conditions(m, ops)
+    work_dir, resume = io.get("work_dir"), io.get("resume")
+    run = run_damage(label, CellStrain(ops), ops.mass, dt, model, None, constraints, t_end, external_force,
+                     samples=samples, checkpoint_every=io.get("checkpoint_every", 0),
+                     work_dir=None if work_dir is None else Path(work_dir),
+                     resume=None if resume is None else Path(resume))
+    return DynamicCrackBandResult(m.num_nodes, m.num_cells, m.h, run, m.centroids, m.x, m.triangles,
+                                  time.perf_counter() - wall)
+
+
 def kalthoff_crack_band(h: float, t_end: float = 80e-6, *, E: float = 1.9e11, nu: float = 0.3,
                         rho: float = 8000.0, ft: float = 9.5e8, GF: float = 2e4, v0: float = 16.5,
                         side: float = 0.1, a1: float = 0.05, a2: float = 0.025, regularized: bool = True,
@@ -407,64 +477,77 @@ def kalthoff_crack_band(h: float, t_end: float = 80e-6, *, E: float = 1.9e11, nu
     Returns:
         The run's result on every rank of ``comm``.
     """
-    if comm.size > 1:
-        result, error = None, None
-        if comm.rank == 0:
-            try:
-                result = kalthoff_crack_band(
-                    h, t_end, E=E, nu=nu, rho=rho, ft=ft, GF=GF, v0=v0, side=side, a1=a1, a2=a2,
-                    regularized=regularized, kappa_c=kappa_c, courant=courant, samples=samples, label=label,
-                    checkpoint_every=checkpoint_every, work_dir=work_dir, resume=resume)
-            except Exception as exc:  # re-raised on every rank
-                error = exc
-        result, error = comm.bcast((result, error), root=0)
-        if error is not None:
-            raise error
-        return result
+    def run() -> DynamicCrackBandResult:
+        wall = time.perf_counter()
+        material = dm.DamageMaterial(E=E, nu=nu, ft=ft, GF=GF, plane="strain")
+        _check_run(material, rho, t_end, samples, regularized, kappa_c)
+        if not np.isfinite(v0):
+            raise InputError(f"impact velocity v0 = {v0!r} must be finite (m/s, e.g. v0=16.5)")
+        m = cracked_plate_mesh(h, width=side, height=side, a1=a1, a2=a2)
 
-    wall = time.perf_counter()
-    material = dm.DamageMaterial(E=E, nu=nu, ft=ft, GF=GF, plane="strain")
-    if not (np.isfinite(rho) and rho > 0):
-        raise InputError(f"density rho = {rho!r} must be positive (kg/m^3, e.g. rho=8000)")
-    if not (np.isfinite(t_end) and t_end > 0):
-        raise InputError(f"t_end = {t_end!r} must be positive (seconds, e.g. t_end=80e-6)")
-    if not np.isfinite(v0):
-        raise InputError(f"impact velocity v0 = {v0!r} must be finite (m/s, e.g. v0=16.5)")
-    if int(samples) != samples or samples < 1:
-        raise InputError(f"samples = {samples!r} must be a positive integer")
-    if regularized:
-        if kappa_c is not None:
-            raise InputError("kappa_c is only used with regularized=False; drop it or set regularized=False")
-    else:
-        if kappa_c is None or not (np.isfinite(kappa_c) and kappa_c > material.kappa0):
-            raise InputError(f"regularized=False needs kappa_c > kappa0 = f_t / E = {material.kappa0:.4g}; "
-                             f"got kappa_c = {kappa_c!r}")
-    _check_geometry(h, side, a1, a2)
-    h_max = 2.0 * E * GF / ft**2
-    m = cracked_plate_mesh(h, side=side, a1=a1, a2=a2)
-    if regularized:
-        # the band width area / chord stays below the longest side
-        longest = np.linalg.norm(np.roll(m.vertices, -1, axis=1) - m.vertices, axis=2).max()
-        if longest >= h_max:
-            raise InputError(f"band too wide: elements up to {longest:.3g} m long may have h_e > 2 E G_F / f_t^2 "
-                             f"= {h_max:.3g} m, where kappa_c <= kappa0 (snap-back); use h < {h_max / 1.5:.3g} m")
-    ops = fem_operators(m, rho)
-    dt = stable_time_step(m, E, nu, rho, courant)
-    n2 = 2 * m.num_nodes
-    model = dm.damage_model(material, ops.area, geometry=triangle_geometry(m.vertices) if regularized else None,
-                            kappa_c=kappa_c, regularized=regularized, band_factor=2.0)
-    tol = 1e-9 * side
-    bottom = np.flatnonzero(np.abs(m.x[:, 1]) < tol)
-    _, lower, _ = slit_sides(m, a1, a2)
-    left = np.abs(m.x[:, 0]) < tol
-    impact = np.flatnonzero(left & (m.x[:, 1] < a2 - tol))
-    impact = np.union1d(impact, lower[np.abs(m.x[lower, 0]) < tol])   # the slit's lower face end
-    v_impact = np.full(len(impact), float(v0))
-    constraints = [Constraint(_identity_rows(2 * bottom + 1, n2)),
-                   Constraint(_identity_rows(2 * impact, n2), velocity=lambda t: v_impact)]
-    run = run_damage(label or f"fem-crack-band h={h:g}", CellStrain(ops), ops.mass, dt, model, None, constraints,
-                     t_end, samples=samples, checkpoint_every=checkpoint_every,
-                     work_dir=None if work_dir is None else Path(work_dir),
-                     resume=None if resume is None else Path(resume))
-    return DynamicCrackBandResult(m.num_nodes, m.num_cells, float(h), run, m.centroids, m.x, m.triangles,
-                                  time.perf_counter() - wall)
+        def conditions(m: CrackedPlateMesh, ops: FemOperators):
+            n2, tol = 2 * m.num_nodes, 1e-9 * side
+            bottom = np.flatnonzero(np.abs(m.x[:, 1]) < tol)
+            _, lower, _ = slit_sides(m, a1, a2)
+            impact = np.flatnonzero((np.abs(m.x[:, 0]) < tol) & (m.x[:, 1] < a2 - tol))
+            impact = np.union1d(impact, lower[np.abs(m.x[lower, 0]) < tol])   # the slit's lower face end
+            v_impact = np.full(len(impact), float(v0))
+            return [Constraint(_identity_rows(2 * bottom + 1, n2)),
+                    Constraint(_identity_rows(2 * impact, n2), velocity=lambda t: v_impact)], None
+
+        io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume}
+        return _crack_band(m, material, rho, t_end, regularized, kappa_c, courant, samples,
+                           label or f"fem-crack-band h={h:g}", conditions, io, wall)
+
+    return _on_root(comm, run)
+
+
+def edge_traction(m: CrackedPlateMesh, sigma: float) -> np.ndarray:
+    """Consistent nodal forces of a normal traction ``sigma`` [Pa] on the bottom (y = 0) and top
+    (y = height) edges, pulling outward: sum_e int_e N_i t ds per interleaved unknown [N/m]."""
+    mesh = m.mesh
+    y0, y1 = m.x[:, 1].min(), m.x[:, 1].max()
+    tol = 1e-9 * (y1 - y0)
+    mesh.topology.create_connectivity(1, 2)
+    facets = dolfinx.mesh.locate_entities_boundary(
+        mesh, 1, lambda x: (np.abs(x[1] - y0) < tol) | (np.abs(x[1] - y1) < tol))
+    tags = dolfinx.mesh.meshtags(mesh, 1, np.sort(facets).astype(np.int32), np.ones(len(facets), np.int32))
+    ds = ufl.Measure("ds", domain=mesh, subdomain_data=tags)
+    v = ufl.TestFunction(m.V)
+    n = ufl.FacetNormal(mesh)
+    t = float(sigma) * n[1] * ufl.as_vector((0.0, 1.0))   # +sigma on top, -sigma on the bottom
+    return dolfinx.fem.assemble_vector(dolfinx.fem.form(ufl.inner(t, v) * ds(1))).array.copy()
+
+
+def branching_crack_band(h: float, t_end: float = 80e-6, *, E: float = 3.2e10, nu: float = 0.2,
+                         rho: float = 2450.0, ft: float = 2.72e6, GF: float = 3.0, sigma: float = 1.0e6,
+                         plane: str = "strain", width: float = 0.1, height: float = 0.04, a1: float = 0.05,
+                         a2: float = 0.02, regularized: bool = True, kappa_c: float | None = None,
+                         courant: float = 0.5, samples: int = 200, label: str | None = None,
+                         checkpoint_every: int = 0, work_dir: str | Path | None = None,
+                         resume: str | Path | None = None, comm: MPI.Comm = MPI.COMM_SELF
+                         ) -> DynamicCrackBandResult:
+    """Run the crack-branching plate (seed 4.3.3) with explicit crack-band finite elements: an
+    edge slit along y = a2 from x = 0 to a1, a step traction ``sigma`` [Pa] on the top and
+    bottom edges from t = 0, no supports (the loads are self-equilibrated).
+
+    Arguments as for ``kalthoff_crack_band``; ``plane`` is ``strain`` or ``stress``, and
+    ``width``, ``height`` give the plate [m].
+    """
+    def run() -> DynamicCrackBandResult:
+        wall = time.perf_counter()
+        material = dm.DamageMaterial(E=E, nu=nu, ft=ft, GF=GF, plane=plane)
+        _check_run(material, rho, t_end, samples, regularized, kappa_c)
+        if not (np.isfinite(sigma) and sigma > 0):
+            raise InputError(f"traction sigma = {sigma!r} must be positive (Pa, e.g. sigma=1e6)")
+        m = cracked_plate_mesh(h, width=width, height=height, a1=a1, a2=a2)
+
+        def conditions(m: CrackedPlateMesh, ops: FemOperators):
+            f = edge_traction(m, sigma)
+            return [], lambda t: f
+
+        io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume}
+        return _crack_band(m, material, rho, t_end, regularized, kappa_c, courant, samples,
+                           label or f"fem-crack-band h={h:g}", conditions, io, wall)
+
+    return _on_root(comm, run)

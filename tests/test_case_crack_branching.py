@@ -96,7 +96,7 @@ def test_dissipation_is_objective_with_regularization_only(quick):
     assert fine < 0.8 * coarse
 
 
-def test_cli_writes_metrics_notes_fem_and_rejects_bad_input(tmp_path, capsys):
+def test_cli_writes_metrics_runs_fem_and_rejects_bad_input(tmp_path, capsys):
     out = tmp_path / "b"
     assert cb.main(["--method", "rkpm", "--set", "h=1.6e-3", "unregularized_h=1.6e-3", "t_end=1e-5",
                     "--out", str(out)]) == 0
@@ -108,13 +108,16 @@ def test_cli_writes_metrics_notes_fem_and_rejects_bad_input(tmp_path, capsys):
     assert "dissipation_change_fine" in summ["errors"] and set(summ["series"]["branches"]) == {"0.0016"}
     for f in ("cracks.png", "damage.png", "damage_unregularized.png", "dissipation.png"):
         assert (out / f).is_file()
+    # The crack-band finite elements: same metrics and figures.
+    assert cb.main(["--method", "fem", "--set", "fem_h=1.6e-3", "t_end=2e-5", "--out", str(tmp_path / "f")]) == 0
+    runs = json.loads((tmp_path / "f" / "results.json").read_text())["runs"]
+    assert [r["method"] for r in runs] == ["fem-crack-band h=0.0016", "fem-crack-band"]
+    assert {"branches", "branch_x", "tip_x", "dissipated_end", "dissipated_in_cracks"} <= set(runs[0]["errors"])
+    assert runs[0]["errors"]["energy_error"] < 1e-3 and runs[0]["errors"]["dissipated_end"] > 0
+    assert (tmp_path / "f" / "cracks_fem.png").is_file()
     capsys.readouterr()
-    # No finite element baseline here: a one-line note and no runs, not a crash.
-    assert cb.main(["--method", "fem", "--out", str(tmp_path / "f")]) == 0
-    assert len(capsys.readouterr().err.strip().splitlines()) == 1
-    assert json.loads((tmp_path / "f" / "results.json").read_text())["runs"] == []
     for bad in (["--set", "h=0.01"], ["--set", "GF=-1"], ["--set", "plane=membrane"], ["--set", "tol=0"],
-                ["--set", "h=abc"], ["--resume", str(tmp_path / "nowhere")]):
+                ["--set", "h=abc"], ["--set", "fem_h=0.05"], ["--resume", str(tmp_path / "nowhere")]):
         with pytest.raises(SystemExit) as err:
             cb.main(["--method", "rkpm", "--out", str(tmp_path / "x"), *bad])
         assert err.value.code == 2

@@ -154,3 +154,28 @@ def test_crack_band_dissipates_g_f_per_crack_length(damaged_run):
     kappa_c = 2 * 2e4 / 9.5e8 * chord / area
     phi = dm.dissipation_density(r.run.kappa[done], 9.5e8 / 1.9e11, kappa_c, 1.9e11)
     assert np.allclose(phi * area, 2e4 * chord, rtol=1e-12)
+
+
+def test_edge_traction_is_the_resultant_on_top_and_bottom():
+    m = cbd.cracked_plate_mesh(0.004, width=0.1, height=0.04, a1=0.05, a2=0.02)
+    f = cbd.edge_traction(m, 1e6).reshape(-1, 2)
+    top, bottom = np.isclose(m.x[:, 1], 0.04), np.isclose(m.x[:, 1], 0.0)
+    # sigma * width on each edge, outward; nothing on the slit faces or the sides.
+    assert f[top, 1].sum() == pytest.approx(1e6 * 0.1, rel=1e-12)
+    assert f[bottom, 1].sum() == pytest.approx(-1e6 * 0.1, rel=1e-12)
+    assert np.abs(f[~(top | bottom)]).max() == 0 and np.abs(f[:, 0]).max() == 0
+
+
+def test_branching_plate_balances_energy_and_cracks_from_the_tip():
+    r = cbd.branching_crack_band(0.002, 40e-6)
+    run = r.run
+    assert run.energy_error < 1e-3
+    kinetic, internal, external = (run.column(c) for c in ("kinetic", "internal", "external"))
+    # The traction's work = kinetic energy + internal work, which holds the dissipation.
+    assert external[-1] == pytest.approx(kinetic[-1] + internal[-1], rel=1e-3)
+    assert internal[-1] > r.dissipated[-1] > 0
+    onset = run.initiation_time
+    first = np.flatnonzero(onset == np.nanmin(onset))
+    assert np.hypot(*(r.centroids[first] - [0.05, 0.02]).T).max() < 2 * 0.002
+    with pytest.raises(InputError, match="sigma"):
+        cbd.branching_crack_band(0.002, sigma=0.0)

@@ -104,6 +104,18 @@ def simulate(label: str, pl: Plate, model: dm.DamageModel, track: Tracking | Non
                       checkpoint_every, work_dir, resume)
 
 
+def run_studies(results, studies: Sequence[tuple[str, Sequence, Callable]], summary: Callable) -> None:
+    """Append to ``results`` the runs ``one(level)`` of each ``(study, levels, one)`` and, after
+    each study's runs, ``summary(study, runs)``."""
+    from ._cli import progress  # noqa: PLC0415
+
+    for study, levels, one in studies:
+        runs = [one(v) for v in progress(levels, study)]
+        results.runs += runs
+        if runs:
+            results.runs.append(summary(study, runs))
+
+
 # --------------------------------------------------------------------------- crack metrics
 
 
@@ -141,6 +153,20 @@ def count_branches(opening: np.ndarray, nx: int, ny: int, columns: np.ndarray, t
         rows = np.flatnonzero(grid[:, i])
         if rows.size:
             out[k] = 1 + int(np.sum(np.diff(rows) > min_gap))
+    return out
+
+
+def count_branches_scattered(points: np.ndarray, opening: np.ndarray, columns: np.ndarray, width: float,
+                             min_gap: float, threshold: float = CRACKED) -> np.ndarray:
+    """``count_branches`` for scattered damage points (e.g. element centroids): the cracked
+    points (w / w_c >= ``threshold``) within ``width`` / 2 of each column x in ``columns``,
+    sorted by y, split into separate cracks where consecutive ones lie more than ``min_gap`` apart."""
+    cracked = np.asarray(points, float)[np.asarray(opening) >= threshold]
+    out = np.zeros(len(columns), int)
+    for k, c in enumerate(columns):
+        y = np.sort(cracked[np.abs(cracked[:, 0] - c) < 0.5 * width, 1])
+        if y.size:
+            out[k] = 1 + int(np.sum(np.diff(y) > min_gap))
     return out
 
 

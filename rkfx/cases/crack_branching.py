@@ -30,8 +30,9 @@ Studies (``h`` lists nominal spacings [m]):
 * ``rkpm-dpm-unregularized``: a constant kappa_c = G_F / (f_t h_0), h_0 the spacing of the
   coarsest model, at ``unregularized_h`` (Fig 4.19a).
 
-There is no finite element baseline for this case: ``--method fem`` runs nothing (with a
-one-line note) and ``--method both`` runs the RKPM studies.
+* ``fem-crack-band``: linear triangles with a crack band and the same damage law, lumped mass,
+  central differences and consistent edge tractions (``fem_baselines.crack_band_dynamics``),
+  at element sizes ``fem_h``; no tracking.
 
 Metrics per run: ``branches``, the number of major branches (``count_branches`` across every
 grid column in x = 0.08-0.095 m; the most frequent nonzero count, ties to the larger),
@@ -44,7 +45,7 @@ energy). A summary run per study maps h to branches and final dissipation
 and gives ``dissipation_change_fine``, |W_d(finest) - W_d(second finest)| / W_d(finest).
 
 Parameters (``--set NAME=VALUE``, SI units): E, nu, rho, ft, GF, sigma, plane, t_end, tol, h,
-unregularized_h, support_factor, courant, radius, forward, eps_p. Long runs: ``--checkpoint-every N`` writes
+unregularized_h, fem_h, support_factor, courant, radius, forward, eps_p. Long runs: ``--checkpoint-every N`` writes
 each model's state every N steps to OUT/checkpoints/, and ``--resume DIR`` continues an
 interrupted invocation (finished models are read back).
 
@@ -82,13 +83,14 @@ PARAMS = {
     "tol": Param(0.5, "particle tracking tolerance of (4.22)"),
     "h": Param([8e-4, 4e-4, 2e-4], "nominal nodal spacings of the regularized models [m]"),
     "unregularized_h": Param([8e-4, 4e-4, 2e-4], "nominal nodal spacings of the constant-kappa_c models [m]"),
+    "fem_h": Param([8e-4, 4e-4, 2e-4], "element sizes of the crack-band finite element baseline [m]"),
     "support_factor": Param(1.75, "RK support radius / nodal spacing (>= 1.6: see rkfx.cases.kalthoff)"),
     "courant": Param(0.5, "dt = courant * h / c_d"),
     "radius": Param(3.5, "tracking neighbourhood radius / nodal spacing"),
     "forward": Param(True, "tracking: candidates only ahead of their particle (false: (4.22) both ways)"),
     "eps_p": Param(1.0, "weight of the MSCNI stabilization (0: plain SCNI)"),
 }
-QUICK = {"h": [1.6e-3, 8e-4], "unregularized_h": [1.6e-3, 8e-4]}
+QUICK = {"h": [1.6e-3, 8e-4], "unregularized_h": [1.6e-3, 8e-4], "fem_h": [1.6e-3, 8e-4]}
 
 
 def _even(length: float, h: float) -> int:
@@ -148,19 +150,22 @@ def _rkpm(label, study, h, material, prm, regularized=True, kappa_c=None, **io) 
 
 
 def branch_metrics(opening: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> tuple[int, float, np.ndarray]:
-    """(branches, branch_x, counts): the most frequent nonzero number of cracks across the
-    columns in ``BRANCH_WINDOW`` (0 if none), the smallest column x > a1 crossed by two or more
-    bands (NaN if none), and the band count of every column x > a1."""
-    nx, ny = len(xs), len(ys)
+    """(branches, branch_x, counts) of a particle grid (``_branches``), with the crack count of
+    every grid column x > a1."""
     right = np.flatnonzero(xs > A1)
-    counts = dyn.count_branches(opening, nx, ny, right)
-    window = (xs[right] >= BRANCH_WINDOW[0] - 1e-12) & (xs[right] <= BRANCH_WINDOW[1] + 1e-12)
+    counts = dyn.count_branches(opening, len(xs), len(ys), right)
+    return (*_branches(counts, xs[right]), counts)
+
+
+def _branches(counts: np.ndarray, column_x: np.ndarray) -> tuple[int, float]:
+    """(branches, branch_x): the most frequent nonzero number of cracks across the columns in
+    ``BRANCH_WINDOW`` (0 if none) and the smallest column x crossed by two or more (NaN if none)."""
+    window = (column_x >= BRANCH_WINDOW[0] - 1e-12) & (column_x <= BRANCH_WINDOW[1] + 1e-12)
     nonzero = [int(c) for c in counts[window] if c > 0]
     # Mode; a tie goes to the larger count.
     branches = max(Counter(nonzero).items(), key=lambda kv: (kv[1], kv[0]))[0] if nonzero else 0
     split = np.flatnonzero(counts >= 2)
-    branch_x = float(xs[right[split[0]]]) if split.size else float("nan")
-    return branches, branch_x, counts
+    return branches, float(column_x[split[0]]) if split.size else float("nan")
 
 
 def _run_record(r: DamageRun, study, h, pl: dyn.Plate, dofs) -> Run:
@@ -173,12 +178,36 @@ def _run_record(r: DamageRun, study, h, pl: dyn.Plate, dofs) -> Run:
     t_init = np.where(cracked, r.initiation_time, np.inf)
     tip_hist = np.array([x[s, 0].max() if (s := t_init <= t + 0.5 * r.dt).any() else np.nan for t in hist[:, 0]])
     series = {**dyn.run_series(r), "tip_x": tip_hist, "column_x": pl.xs[pl.xs > A1], "column_bands": counts}
-    errors = {"branches": branches, "branch_x": branch_x, "tip_x": tip_x, "dissipated_end": float(hist[-1, 1]),
-              "dissipated_in_cracks": dyn.crack_share(r),
-              "energy_error": r.energy_error}
     info = {"study": study, "h_nominal": h, "nx": len(pl.xs), "ny": len(pl.ys), "h": pl.h, "steps": r.steps,
             "dt": r.dt}
-    return Run(r.label, r.wall_time_s, dofs, series, errors, info)
+    return Run(r.label, r.wall_time_s, dofs, series, _errors(r, branches, branch_x, tip_x), info)
+
+
+def _errors(r: DamageRun, branches: int, branch_x: float, tip_x: float) -> dict:
+    return {"branches": branches, "branch_x": branch_x, "tip_x": tip_x, "dissipated_end": float(r.history[-1, 1]),
+            "dissipated_in_cracks": dyn.crack_share(r), "energy_error": r.energy_error}
+
+
+def _fem(h: float, prm: dict, io: dict) -> Run:
+    import dolfinx_solver  # noqa: F401, PLC0415
+
+    from fem_baselines.crack_band_dynamics import branching_crack_band  # noqa: PLC0415
+
+    res = branching_crack_band(h, prm["t_end"], E=prm["E"], nu=prm["nu"], rho=prm["rho"], ft=prm["ft"], GF=prm["GF"],
+                               sigma=prm["sigma"], plane=prm["plane"], width=LX, height=LY, a1=A1, a2=A2,
+                               courant=prm["courant"], label=f"fem-crack-band h={h:g}", **io)
+    r = res.run
+    columns = np.arange(A1 + 0.5 * h, LX, h)
+    counts = dyn.count_branches_scattered(res.centroids, r.opening, columns, h, 3.0 * h)
+    cracked = r.opening >= dyn.CRACKED
+    tip_x = float(res.centroids[cracked, 0].max()) if cracked.any() else float("nan")
+    series = dyn.run_series(r)
+    # The damaged cells' vertices (not the whole mesh): what the figures draw.
+    series["damaged_cells"] = np.round(res.x[res.triangles[np.asarray(series["damaged_index"], int)]], 7)
+    series.update(column_x=columns, column_bands=counts)
+    info = {"study": "fem", "h_nominal": h, "h": h, "cells": res.num_cells, "steps": r.steps, "dt": r.dt}
+    return Run(r.label, r.wall_time_s, 2 * res.num_nodes, series, _errors(r, *_branches(counts, columns), tip_x),
+               info)
 
 
 def _summary(study: str, runs: Sequence[Run]) -> Run:
@@ -199,30 +228,30 @@ def _summary(study: str, runs: Sequence[Run]) -> Run:
 
 def run(*, methods: Sequence[str] = ("rkpm",), E=3.2e10, nu=0.2, rho=2450.0, ft=2.72e6, GF=3.0, sigma=1.0e6,
         plane="strain", t_end=80e-6, tol=0.5, h=(8e-4, 4e-4, 2e-4), unregularized_h=(8e-4, 4e-4, 2e-4),
-        support_factor=1.75, courant=0.5, radius=3.5, forward=True, eps_p=1.0, checkpoint_every=0, work_dir=None,
-        resume=None) -> Results:
-    """The damage particle method, regularized and with a constant kappa_c, at each spacing."""
-    hs, unreg = [float(v) for v in h], [float(v) for v in unregularized_h]
-    material = _check(E, nu, rho, ft, GF, sigma, plane, t_end, tol, hs + unreg, support_factor, courant, radius)
+        fem_h=(8e-4, 4e-4, 2e-4), support_factor=1.75, courant=0.5, radius=3.5, forward=True, eps_p=1.0,
+        checkpoint_every=0, work_dir=None, resume=None) -> Results:
+    """The damage particle method, regularized and with a constant kappa_c, at each spacing,
+    and the crack-band finite elements at each element size."""
+    hs, unreg, fems = [float(v) for v in h], [float(v) for v in unregularized_h], [float(v) for v in fem_h]
+    material = _check(E, nu, rho, ft, GF, sigma, plane, t_end, tol, hs + unreg + fems, support_factor, courant,
+                      radius)
     prm = dict(E=E, nu=nu, rho=rho, ft=ft, GF=GF, sigma=sigma, plane=plane, t_end=t_end, tol=tol, h=hs,
-               unregularized_h=unreg, support_factor=support_factor, courant=courant, radius=radius, forward=forward,
-               eps_p=eps_p)
+               unregularized_h=unreg, fem_h=fems, support_factor=support_factor, courant=courant, radius=radius,
+               forward=forward, eps_p=eps_p)
     io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume}
     xs, ys = grid(max(hs + unreg) if hs + unreg else 8e-4)
     h0 = float(max(np.diff(xs).max(), np.diff(ys).max()))
     kappa_c = GF / (ft * h0)
     results = Results(NAME, {**prm, "kappa0": material.kappa0, "kappa_c_unregularized": kappa_c})
-    if "rkpm" not in methods:
-        if _cli._rank() == 0:
-            print(f"{NAME}: no finite element baseline for this case; --method fem runs nothing "
-                  "(use --method rkpm or both)", file=sys.stderr)
-        return results
-    for study, levels, kw in (("rkpm-dpm", hs, {}),
-                              ("rkpm-dpm-unregularized", unreg, {"regularized": False, "kappa_c": kappa_c})):
-        runs = [_rkpm(f"{study} h={v:g}", study, v, material, prm, **kw, **io) for v in _cli.progress(levels, study)]
-        results.runs += runs
-        if runs:
-            results.runs.append(_summary(study, runs))
+    studies = []
+    if "rkpm" in methods:
+        studies += [(study, levels, lambda v, study=study, kw=kw: _rkpm(f"{study} h={v:g}", study, v, material, prm,
+                                                                        **kw, **io))
+                    for study, levels, kw in (("rkpm-dpm", hs, {}), ("rkpm-dpm-unregularized", unreg,
+                                                                       {"regularized": False, "kappa_c": kappa_c}))]
+    if "fem" in methods:
+        studies.append(("fem-crack-band", fems, lambda v: _fem(v, prm, io)))
+    dyn.run_studies(results, studies, _summary)
     return results
 
 
@@ -230,7 +259,16 @@ def run(*, methods: Sequence[str] = ("rkpm",), E=3.2e10, nu=0.2, rho=2450.0, ft=
 
 
 def _damage_map(ax, r: Run, key: str = "damaged_D"):
-    m = dyn.damage_map(ax, r.series, r.info["nx"], r.info["ny"], LX, LY, key)
+    if "cells" in r.info:  # crack-band FEM: the damaged triangles
+        from matplotlib.collections import PolyCollection  # noqa: PLC0415
+
+        m = PolyCollection(np.asarray(r.series["damaged_cells"], float).reshape(-1, 3, 2),
+                           array=np.asarray(r.series[key], float), cmap="inferno_r", clim=(0, 1),
+                           edgecolors="face", linewidths=0.1, rasterized=True)
+        ax.set_facecolor(m.cmap(0.0))
+        ax.add_collection(m)
+    else:
+        m = dyn.damage_map(ax, r.series, r.info["nx"], r.info["ny"], LX, LY, key)
     ax.plot([0, A1], [A2, A2], color="tab:blue", lw=2)
     for xb in BRANCH_WINDOW:
         ax.axvline(xb, color="tab:green", lw=0.8, ls=":")
@@ -249,7 +287,8 @@ def _title(r: Run) -> str:
     e = r.errors
     bx = e["branch_x"]
     split = f", splits at x = {1e3 * bx:.0f} mm" if bx is not None and np.isfinite(bx) else ""
-    return (f"h = {1e3 * r.info['h']:.3f} mm ({r.info['nx']} x {r.info['ny']} particles): {e['branches']} "
+    size = f"{r.info['cells']:,} cells" if "cells" in r.info else f"{r.info['nx']} x {r.info['ny']} particles"
+    return (f"h = {1e3 * r.info['h']:.3f} mm ({size}): {e['branches']} "
             f"branch(es){split}, dissipated {e['dissipated_end']:.3f} J/m")
 
 
@@ -261,7 +300,8 @@ def plot(results: Results, out: Path) -> list[Path]:
     for study, fname, head, key in (
             ("rkpm-dpm", "cracks", "damage particle method (regularized)", "damaged_w"),
             ("rkpm-dpm", "damage", "damage particle method (regularized)", "damaged_D"),
-            ("rkpm-dpm-unregularized", "damage_unregularized", "constant $\\kappa_c$", "damaged_D")):
+            ("rkpm-dpm-unregularized", "damage_unregularized", "constant $\\kappa_c$", "damaged_D"),
+            ("fem", "cracks_fem", "crack-band finite elements (no tracking)", "damaged_w")):
         runs = sorted((r for r in results.runs if r.info.get("study") == study), key=lambda r: -r.info["h"])
         if not runs:
             continue
@@ -277,7 +317,7 @@ def plot(results: Results, out: Path) -> list[Path]:
         files.append(_cli.save(fig, out / f"{fname}.png"))
     path = dyn.plot_dissipation(
         results, (("rkpm-dpm-unregularized", "(a) unregularized: constant $\\kappa_c$"),
-                  ("rkpm-dpm", "(b) damage particle method, regularized (4.28)")),
+                  ("rkpm-dpm", "(b) damage particle method, regularized (4.28)"), ("fem", "(c) crack-band FEM")),
         out / "dissipation.png", "crack branching: global fracture energy dissipation",
         label=lambda r: f"h = {1e3 * r.info['h']:.3f} mm", order=lambda r: -r.info["h"])
     if path:

@@ -202,20 +202,16 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.9e11, nu=0.3, rho=8000.
     coarse = min(nodes + unreg) if nodes + unreg else 150
     kappa_c = GF / (ft * (SIDE / (grid(coarse)[0].size - 1)))
     results = Results(NAME, {**prm, "kappa0": material.kappa0, "kappa_c_unregularized": kappa_c})
+    studies = []
     if "rkpm" in methods:
-        studies = [("rkpm-dpm", nodes, {}), ("rkpm-dpm-unregularized", unreg, {"regularized": False,
-                                                                               "kappa_c": kappa_c}),
-                   ("rkpm-dpm-no-tracking", free, {"tracked": False})]
-        for study, ns, kw in studies:
-            runs = [_rkpm(f"{study} n={n}", study, n, material, prm, **kw, **io)
-                    for n in _cli.progress(ns, study)]
-            results.runs += runs
-            if runs:
-                results.runs.append(_summary(study, runs))
-    if "fem" in methods and fem:
-        runs = [_fem(n, prm, io) for n in _cli.progress(fem, "fem-crack-band")]
-        results.runs += runs
-        results.runs.append(_summary("fem-crack-band", runs))
+        studies += [(study, ns, lambda n, study=study, kw=kw: _rkpm(f"{study} n={n}", study, n, material, prm,
+                                                                    **kw, **io))
+                    for study, ns, kw in (("rkpm-dpm", nodes, {}),
+                                          ("rkpm-dpm-unregularized", unreg, {"regularized": False, "kappa_c": kappa_c}),
+                                          ("rkpm-dpm-no-tracking", free, {"tracked": False}))]
+    if "fem" in methods:
+        studies.append(("fem-crack-band", fem, lambda n: _fem(n, prm, io)))
+    dyn.run_studies(results, studies, _summary)
     return results
 
 
