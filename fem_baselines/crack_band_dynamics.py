@@ -58,7 +58,6 @@ Units: SI (m, s, kg, Pa, N/m); energies are per unit thickness [J/m].
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -80,6 +79,7 @@ from rkfx import damage as dm
 from rkfx.errors import InputError
 from rkfx.explicit import Constraint
 from rkfx.explicit_damage import DamageRun, run_damage
+from rkfx.ranks import on_root
 
 __all__ = [
     "CellStrain",
@@ -391,22 +391,6 @@ def _identity_rows(dofs: np.ndarray, n2: int) -> sp.csr_matrix:
     return sp.csr_matrix((np.ones(k), (np.arange(k), dofs)), shape=(k, n2))
 
 
-def _on_root(comm: MPI.Comm, run: Callable[[], DynamicCrackBandResult]) -> DynamicCrackBandResult:
-    """``run()`` on rank 0 of ``comm`` (on ``MPI.COMM_SELF``), its result (or error) on every rank."""
-    if comm.size == 1:
-        return run()
-    result, error = None, None
-    if comm.rank == 0:
-        try:
-            result = run()
-        except Exception as exc:  # re-raised on every rank
-            error = exc
-    result, error = comm.bcast((result, error), root=0)
-    if error is not None:
-        raise error
-    return result
-
-
 def _check_run(material: dm.DamageMaterial, rho: float, t_end: float, samples: int, regularized: bool,
                kappa_c: float | None) -> None:
     if not (np.isfinite(rho) and rho > 0):
@@ -499,7 +483,7 @@ def kalthoff_crack_band(h: float, t_end: float = 80e-6, *, E: float = 1.9e11, nu
         return _crack_band(m, material, rho, t_end, regularized, kappa_c, courant, samples,
                            label or f"fem-crack-band h={h:g}", conditions, io, wall)
 
-    return _on_root(comm, run)
+    return on_root(comm, run)
 
 
 def edge_traction(m: CrackedPlateMesh, sigma: float) -> np.ndarray:
@@ -550,4 +534,4 @@ def branching_crack_band(h: float, t_end: float = 80e-6, *, E: float = 3.2e10, n
         return _crack_band(m, material, rho, t_end, regularized, kappa_c, courant, samples,
                            label or f"fem-crack-band h={h:g}", conditions, io, wall)
 
-    return _on_root(comm, run)
+    return on_root(comm, run)

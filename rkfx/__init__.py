@@ -19,6 +19,7 @@ The numerical core (this package's top-level modules) needs only numpy, scipy an
     crack_tracking   candidate damage particles along crack segments (eq. 4.22)
     explicit_damage  damage particle method in explicit dynamics: compiled update, runs kept on disk
     linear_solver    factorized systems through PETSc when installed, else SciPy
+    ranks            serial work under MPI: rank 0 runs it, every rank gets the result
     warmup           compile the kernels before timing
 
 ``rkfx.petsc`` (imported on purpose) hands the sparse operators to PETSc; ``rkfx.cases``

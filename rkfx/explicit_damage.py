@@ -53,6 +53,7 @@ from .crack_tracking import Tracking
 from .damage import DamageModel, chord_lengths, crack_opening, critical_strain, dissipation_density
 from .errors import InputError
 from .explicit import Constraint, ExplicitDynamics, run_explicit
+from .ranks import on_root
 
 HISTORY = ("time", "dissipated", "damaged", "kinetic", "internal", "external")
 
@@ -312,7 +313,8 @@ class DamageRun:
 def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, model: DamageModel,
                track: Tracking | None, constraints: Sequence[Constraint], t_end: float,
                external_force: Callable[[float], np.ndarray] | None = None, samples: int = 200,
-               checkpoint_every: int = 0, work_dir: Path | None = None, resume: Path | None = None) -> DamageRun:
+               checkpoint_every: int = 0, work_dir: Path | None = None, resume: Path | None = None,
+               comm=None) -> DamageRun:
     """Explicit dynamics with the damage of ``model`` to ``t_end`` (``samples`` history points),
     keeping finished work.
 
@@ -326,7 +328,13 @@ def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, mode
         work_dir: Where finished results and checkpoints go.
         resume: Work directory of an interrupted invocation: a finished result there is
             returned as is, a checkpoint is continued.
+        comm: An MPI communicator (mpi4py) or ``None``. The run is serial: with several ranks,
+            rank 0 runs it and writes the files, and every rank receives the result (or the
+            error).
     """
+    if comm is not None and comm.size > 1:
+        return on_root(comm, lambda: run_damage(label, op, mass, dt, model, track, constraints, t_end,
+                                                external_force, samples, checkpoint_every, work_dir, resume))
     if not t_end > 0:
         raise InputError(f"t_end = {t_end!r} must be positive (seconds)")
     if checkpoint_every and work_dir is None:

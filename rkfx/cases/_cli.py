@@ -19,6 +19,7 @@ Results go to ``DIR/results.json`` (default ``results/<name>/``) with the schema
 import argparse
 import json
 import math
+import os
 import sys
 import textwrap
 from collections.abc import Callable, Iterable, Mapping, Sequence
@@ -137,10 +138,23 @@ def _fail(prog: str, message: str):
     raise SystemExit(2)
 
 
-def _rank() -> int:
-    # Without importing mpi4py here: dolfinx_solver must load MPI first.
+def comm():
+    """MPI.COMM_WORLD when this process runs under MPI (mpi4py loaded, or launched by mpiexec
+    with more than one rank), else ``None``. Under mpiexec MPI is loaded here, through
+    ``dolfinx_solver`` (which must come before mpi4py)."""
     mpi = sys.modules.get("mpi4py.MPI")
-    return mpi.COMM_WORLD.rank if mpi is not None else 0
+    if mpi is None and max(int(os.environ.get(k, "1") or 1) for k in _MPI_SIZE_VARS) > 1:
+        import dolfinx_solver  # noqa: F401, PLC0415
+        from mpi4py import MPI as mpi  # noqa: N812, PLC0415
+    return mpi.COMM_WORLD if mpi is not None else None
+
+
+_MPI_SIZE_VARS = ("PMI_SIZE", "OMPI_COMM_WORLD_SIZE")  # set by MPICH and Open MPI launchers
+
+
+def _rank() -> int:
+    c = comm()
+    return c.rank if c is not None else 0
 
 
 def build_parser(name: str, doc: str | None, specs: Mapping[str, Param],

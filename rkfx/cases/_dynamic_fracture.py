@@ -98,10 +98,12 @@ def damage_model(pl: Plate, material: dm.DamageMaterial, regularized: bool = Tru
 
 def simulate(label: str, pl: Plate, model: dm.DamageModel, track: Tracking | None, constraints: Sequence[Constraint],
              t_end: float, external_force: Callable[[float], np.ndarray] | None = None, samples: int = 200,
-             checkpoint_every: int = 0, work_dir: Path | None = None, resume: Path | None = None) -> DamageRun:
-    """The damage particle method on the plate to ``t_end`` (``rkfx.explicit_damage.run_damage``)."""
+             checkpoint_every: int = 0, work_dir: Path | None = None, resume: Path | None = None,
+             comm=None) -> DamageRun:
+    """The damage particle method on the plate to ``t_end`` (``rkfx.explicit_damage.run_damage``;
+    with an MPI ``comm`` of several ranks, rank 0 runs it)."""
     return run_damage(label, pl.op, pl.mass, pl.dt, model, track, constraints, t_end, external_force, samples,
-                      checkpoint_every, work_dir, resume)
+                      checkpoint_every, work_dir, resume, comm)
 
 
 def run_studies(results, studies: Sequence[tuple[str, Sequence, Callable]], summary: Callable) -> None:

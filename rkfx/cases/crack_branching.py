@@ -238,7 +238,7 @@ def run(*, methods: Sequence[str] = ("rkpm",), E=3.2e10, nu=0.2, rho=2450.0, ft=
     prm = dict(E=E, nu=nu, rho=rho, ft=ft, GF=GF, sigma=sigma, plane=plane, t_end=t_end, tol=tol, h=hs,
                unregularized_h=unreg, fem_h=fems, support_factor=support_factor, courant=courant, radius=radius,
                forward=forward, eps_p=eps_p)
-    io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume}
+    io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume, "comm": _cli.comm()}
     xs, ys = grid(max(hs + unreg) if hs + unreg else 8e-4)
     h0 = float(max(np.diff(xs).max(), np.diff(ys).max()))
     kappa_c = GF / (ft * h0)

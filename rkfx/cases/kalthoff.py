@@ -198,7 +198,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.9e11, nu=0.3, rho=8000.
            "unregularized_nodes": unreg, "no_tracking_nodes": free, "fem_nodes": fem,
            "support_factor": support_factor, "courant": courant, "radius": radius, "forward": forward, "eps_p": eps_p,
            "angle_radius": angle_radius}
-    io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume}
+    io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume, "comm": _cli.comm()}
     coarse = min(nodes + unreg) if nodes + unreg else 150
     kappa_c = GF / (ft * (SIDE / (grid(coarse)[0].size - 1)))
     results = Results(NAME, {**prm, "kappa0": material.kappa0, "kappa_c_unregularized": kappa_c})
