@@ -59,6 +59,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 import dolfinx_solver  # noqa: F401  (must precede dolfinx / petsc4py: orders MPI loading)
@@ -78,7 +79,7 @@ import ufl
 from rkfx import damage as dm
 from rkfx.errors import InputError
 from rkfx.explicit import Constraint
-from rkfx.explicit_damage import DamageRun, run_damage
+from rkfx.explicit_damage import DamageRun, run_damage, run_key
 from rkfx.ranks import on_root
 
 __all__ = [
@@ -96,6 +97,9 @@ __all__ = [
     "triangle_geometry",
 ]
 
+
+
+MESH_FILE = "mesh.npz"  # the nodes and cells of a finished run, beside its result.npz
 
 
 # --------------------------------------------------------------------------- geometry
@@ -407,11 +411,21 @@ def _check_run(material: dm.DamageMaterial, rho: float, t_end: float, samples: i
                          f"got kappa_c = {kappa_c!r}")
 
 
-def _crack_band(m: CrackedPlateMesh, material: dm.DamageMaterial, rho: float, t_end: float, regularized: bool,
+def _crack_band(mesh, material: dm.DamageMaterial, rho: float, t_end: float, regularized: bool,
                 kappa_c: float | None, courant: float, samples: int, label: str, conditions, io: dict,
                 wall: float) -> DynamicCrackBandResult:
-    """The explicit crack-band run on the mesh ``m``; ``conditions(m, ops) -> (constraints,
-    external_force)`` sets up the problem's loads."""
+    """The explicit crack-band run on the mesh ``mesh()``; ``conditions(m, ops) -> (constraints,
+    external_force)`` sets up the problem's loads. A finished run in ``io["resume"]`` is read
+    back with its mesh's nodes and cells, without meshing again."""
+    work_dir, resume = io.get("work_dir"), io.get("resume")
+    done = None if resume is None else Path(resume) / run_key(label)
+    if done is not None and (done / "result.npz").is_file() and (done / MESH_FILE).is_file():
+        with np.load(done / MESH_FILE) as z:
+            x, tri, h = z["x"], z["triangles"], float(z["h"])
+        run = DamageRun.load(done / "result.npz")
+        return DynamicCrackBandResult(len(x), len(tri), h, run, x[tri].mean(axis=1), x, tri,
+                                      time.perf_counter() - wall)
+    m = mesh()
     if regularized:
         # the band width area / chord stays below the longest side
         h_max = 2.0 * material.E * material.GF / material.ft**2
@@ -424,11 +438,12 @@ def _crack_band(m: CrackedPlateMesh, material: dm.DamageMaterial, rho: float, t_
     model = dm.damage_model(material, ops.area, geometry=triangle_geometry(m.vertices) if regularized else None,
                             kappa_c=kappa_c, regularized=regularized, band_factor=2.0)
     constraints, external_force = conditions(m, ops)
-    work_dir, resume = io.get("work_dir"), io.get("resume")
     run = run_damage(label, CellStrain(ops), ops.mass, dt, model, None, constraints, t_end, external_force,
                      samples=samples, checkpoint_every=io.get("checkpoint_every", 0),
                      work_dir=None if work_dir is None else Path(work_dir),
                      resume=None if resume is None else Path(resume))
+    if work_dir is not None:  # beside result.npz, so that a resume reads the run back without meshing
+        np.savez(Path(work_dir) / run_key(label) / MESH_FILE, x=m.x, triangles=m.triangles, h=m.h)
     return DynamicCrackBandResult(m.num_nodes, m.num_cells, m.h, run, m.centroids, m.x, m.triangles,
                                   time.perf_counter() - wall)
 
@@ -467,7 +482,8 @@ def kalthoff_crack_band(h: float, t_end: float = 80e-6, *, E: float = 1.9e11, nu
         _check_run(material, rho, t_end, samples, regularized, kappa_c)
         if not np.isfinite(v0):
             raise InputError(f"impact velocity v0 = {v0!r} must be finite (m/s, e.g. v0=16.5)")
-        m = cracked_plate_mesh(h, width=side, height=side, a1=a1, a2=a2)
+        _check_geometry(h, side, side, a1, a2)
+        mesh = partial(cracked_plate_mesh, h, width=side, height=side, a1=a1, a2=a2)
 
         def conditions(m: CrackedPlateMesh, ops: FemOperators):
             n2, tol = 2 * m.num_nodes, 1e-9 * side
@@ -480,7 +496,7 @@ def kalthoff_crack_band(h: float, t_end: float = 80e-6, *, E: float = 1.9e11, nu
                     Constraint(_identity_rows(2 * impact, n2), velocity=lambda t: v_impact)], None
 
         io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume}
-        return _crack_band(m, material, rho, t_end, regularized, kappa_c, courant, samples,
+        return _crack_band(mesh, material, rho, t_end, regularized, kappa_c, courant, samples,
                            label or f"fem-crack-band h={h:g}", conditions, io, wall)
 
     return on_root(comm, run)
@@ -524,14 +540,15 @@ def branching_crack_band(h: float, t_end: float = 80e-6, *, E: float = 3.2e10, n
         _check_run(material, rho, t_end, samples, regularized, kappa_c)
         if not (np.isfinite(sigma) and sigma > 0):
             raise InputError(f"traction sigma = {sigma!r} must be positive (Pa, e.g. sigma=1e6)")
-        m = cracked_plate_mesh(h, width=width, height=height, a1=a1, a2=a2)
+        _check_geometry(h, width, height, a1, a2)
+        mesh = partial(cracked_plate_mesh, h, width=width, height=height, a1=a1, a2=a2)
 
         def conditions(m: CrackedPlateMesh, ops: FemOperators):
             f = edge_traction(m, sigma)
             return [], lambda t: f
 
         io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume}
-        return _crack_band(m, material, rho, t_end, regularized, kappa_c, courant, samples,
+        return _crack_band(mesh, material, rho, t_end, regularized, kappa_c, courant, samples,
                            label or f"fem-crack-band h={h:g}", conditions, io, wall)
 
     return on_root(comm, run)

@@ -310,6 +310,11 @@ class DamageRun:
                        float(z["dt"]), float(z["wall_time_s"]), float(z["energy_error"]))
 
 
+def run_key(label: str) -> str:
+    """The folder of a run's files (result, checkpoint) in a work directory."""
+    return label.replace(" ", "_").replace("=", "")
+
+
 def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, model: DamageModel,
                track: Tracking | None, constraints: Sequence[Constraint], t_end: float,
                external_force: Callable[[float], np.ndarray] | None = None, samples: int = 200,
@@ -339,7 +344,7 @@ def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, mode
         raise InputError(f"t_end = {t_end!r} must be positive (seconds)")
     if checkpoint_every and work_dir is None:
         raise InputError("checkpoint_every needs a work directory (the case's --out)")
-    key = label.replace(" ", "_").replace("=", "")
+    key = run_key(label)
     if resume is not None and (Path(resume) / key / "result.npz").is_file():
         return DamageRun.load(Path(resume) / key / "result.npz")
     steps = int(np.ceil(t_end / dt - 1e-9))

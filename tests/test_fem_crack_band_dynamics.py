@@ -179,3 +179,17 @@ def test_branching_plate_balances_energy_and_cracks_from_the_tip():
     assert np.hypot(*(r.centroids[first] - [0.05, 0.02]).T).max() < 2 * 0.002
     with pytest.raises(InputError, match="sigma"):
         cbd.branching_crack_band(0.002, sigma=0.0)
+
+
+def test_resume_reads_a_finished_run_back_without_meshing(tmp_path, monkeypatch):
+    first = cbd.branching_crack_band(0.004, 5e-6, work_dir=tmp_path)
+
+    def no_mesh(*args, **kwargs):
+        raise AssertionError("meshed again")
+
+    monkeypatch.setattr(cbd, "cracked_plate_mesh", no_mesh)
+    again = cbd.branching_crack_band(0.004, 5e-6, resume=tmp_path)
+    np.testing.assert_array_equal(again.run.history, first.run.history)
+    np.testing.assert_array_equal(again.triangles, first.triangles)
+    np.testing.assert_array_equal(again.centroids, first.centroids)
+    assert (again.num_nodes, again.num_cells, again.h) == (first.num_nodes, first.num_cells, first.h)
