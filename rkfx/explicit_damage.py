@@ -294,10 +294,8 @@ class DamageRun:
         tmp = path.with_suffix(".tmp.npz")
         np.savez(tmp, history=self.history, damage=self.damage, kappa=self.kappa, normal=self.normal,
                  initiation_time=self.initiation_time, opening=self.opening, dissipation=self.dissipation,
-                 displacement=self.displacement,
-                 velocity=self.velocity,
-                 steps=self.steps, dt=self.dt, wall_time_s=self.wall_time_s,
-                 energy_error=self.energy_error, label=self.label)
+                 displacement=self.displacement, velocity=self.velocity, steps=self.steps, dt=self.dt,
+                 wall_time_s=self.wall_time_s, energy_error=self.energy_error, label=self.label)
         tmp.replace(path)
 
     @classmethod
