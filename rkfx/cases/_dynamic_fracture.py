@@ -145,24 +145,11 @@ def crack_share(r: DamageRun) -> float:
     return float(np.sum(r.dissipation[r.opening >= CRACKED])) / total if total > 0 else float("nan")
 
 
-def count_branches(opening: np.ndarray, nx: int, ny: int, columns: np.ndarray, threshold: float = CRACKED,
-                   min_gap: int = 3) -> np.ndarray:
-    """Number of separate cracks crossing each grid column in ``columns``: runs of particles
-    with w / w_c >= ``threshold`` along the column, runs closer than ``min_gap`` rows merged."""
-    grid = opening.reshape(ny, nx) >= threshold
-    out = np.zeros(len(columns), int)
-    for k, i in enumerate(columns):
-        rows = np.flatnonzero(grid[:, i])
-        if rows.size:
-            out[k] = 1 + int(np.sum(np.diff(rows) > min_gap))
-    return out
-
-
-def count_branches_scattered(points: np.ndarray, opening: np.ndarray, columns: np.ndarray, width: float,
-                             min_gap: float, threshold: float = CRACKED) -> np.ndarray:
-    """``count_branches`` for scattered damage points (e.g. element centroids): the cracked
-    points (w / w_c >= ``threshold``) within ``width`` / 2 of each column x in ``columns``,
-    sorted by y, split into separate cracks where consecutive ones lie more than ``min_gap`` apart."""
+def count_branches(points: np.ndarray, opening: np.ndarray, columns: np.ndarray, width: float,
+                   min_gap: float, threshold: float = CRACKED) -> np.ndarray:
+    """Number of separate cracks crossing each column x in ``columns``: the cracked damage
+    points (particles or element centroids, w / w_c >= ``threshold``) within ``width`` / 2 of
+    the column, sorted by y, split where consecutive ones lie more than ``min_gap`` apart."""
     cracked = np.asarray(points, float)[np.asarray(opening) >= threshold]
     out = np.zeros(len(columns), int)
     for k, c in enumerate(columns):

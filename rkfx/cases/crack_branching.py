@@ -152,9 +152,12 @@ def _rkpm(label, study, h, material, prm, regularized=True, kappa_c=None, **io) 
 def branch_metrics(opening: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> tuple[int, float, np.ndarray]:
     """(branches, branch_x, counts) of a particle grid (``_branches``), with the crack count of
     every grid column x > a1."""
-    right = np.flatnonzero(xs > A1)
-    counts = dyn.count_branches(opening, len(xs), len(ys), right)
-    return (*_branches(counts, xs[right]), counts)
+    columns = xs[xs > A1]
+    points = np.stack(np.meshgrid(xs, ys), axis=-1).reshape(-1, 2)  # particle order: x fastest
+    dx, dy = np.diff(xs).min(), np.diff(ys).min()
+    # Runs of cracked particles more than three rows apart are separate cracks.
+    counts = dyn.count_branches(points, opening, columns, dx, 3.5 * dy)
+    return (*_branches(counts, columns), counts)
 
 
 def _branches(counts: np.ndarray, column_x: np.ndarray) -> tuple[int, float]:
@@ -198,7 +201,7 @@ def _fem(h: float, prm: dict, io: dict) -> Run:
                                courant=prm["courant"], label=f"fem-crack-band h={h:g}", **io)
     r = res.run
     columns = np.arange(A1 + 0.5 * h, LX, h)
-    counts = dyn.count_branches_scattered(res.centroids, r.opening, columns, h, 3.0 * h)
+    counts = dyn.count_branches(res.centroids, r.opening, columns, h, 3.0 * h)
     cracked = r.opening >= dyn.CRACKED
     tip_x = float(res.centroids[cracked, 0].max()) if cracked.any() else float("nan")
     series = dyn.run_series(r)
