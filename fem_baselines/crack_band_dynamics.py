@@ -443,7 +443,9 @@ def _crack_band(mesh, material: dm.DamageMaterial, rho: float, t_end: float, reg
                      work_dir=None if work_dir is None else Path(work_dir),
                      resume=None if resume is None else Path(resume))
     if work_dir is not None:  # beside result.npz, so that a resume reads the run back without meshing
-        np.savez(Path(work_dir) / run_key(label) / MESH_FILE, x=m.x, triangles=m.triangles, h=m.h)
+        folder = Path(work_dir) / run_key(label)
+        folder.mkdir(parents=True, exist_ok=True)  # a run read back from elsewhere wrote nothing here
+        np.savez(folder / MESH_FILE, x=m.x, triangles=m.triangles, h=m.h)
     return DynamicCrackBandResult(m.num_nodes, m.num_cells, m.h, run, m.centroids, m.x, m.triangles,
                                   time.perf_counter() - wall)
 

@@ -193,3 +193,11 @@ def test_resume_reads_a_finished_run_back_without_meshing(tmp_path, monkeypatch)
     np.testing.assert_array_equal(again.triangles, first.triangles)
     np.testing.assert_array_equal(again.centroids, first.centroids)
     assert (again.num_nodes, again.num_cells, again.h) == (first.num_nodes, first.num_cells, first.h)
+
+
+def test_resume_of_a_run_without_saved_mesh_meshes_and_writes_to_the_new_work_dir(tmp_path):
+    first = cbd.branching_crack_band(0.004, 5e-6, work_dir=tmp_path / "a")
+    (tmp_path / "a" / "fem-crack-band_h0.004" / cbd.MESH_FILE).unlink()   # as written by an older rkfx
+    again = cbd.branching_crack_band(0.004, 5e-6, resume=tmp_path / "a", work_dir=tmp_path / "b")
+    np.testing.assert_array_equal(again.run.history, first.run.history)
+    assert (tmp_path / "b" / "fem-crack-band_h0.004" / cbd.MESH_FILE).is_file()
