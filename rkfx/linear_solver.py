@@ -35,3 +35,44 @@ def linear_solver(a: sp.spmatrix, comm=None, solver: str = "mumps"):
             raise InputError(f"solver {solver!r} needs PETSc: pip install 'rkfx[fem]'") from None
         return _ScipyLU(a)
     return petsc.LinearSolver(a, comm if comm is not None else petsc.MPI.COMM_WORLD, solver)
+
+
+class Factorizations:
+    """The linear-solver door of the steppers: one factorization per key, a few kept.
+
+    A linear model keyed by its step size reuses the factorization of every step of that size;
+    ``key=None`` factorizes anew (a Newton iteration of a nonlinear model).
+
+    Args:
+        comm: Communicator (PETSc when installed).
+        solver: ``mumps``, ``gmres-ilu`` or ``cg-gamg`` (see ``rkfx.petsc``).
+        keep: Factorizations kept at once (the oldest is freed first).
+    """
+
+    def __init__(self, comm=None, solver: str = "mumps", keep: int = 5):
+        self.comm, self.solver, self.keep = comm, solver, int(keep)
+        self._cache: dict = {}
+        self.count = 0  # factorizations made
+
+    def get(self, key, build):
+        """The solver for ``key``, factorizing ``build()`` when it is not cached."""
+        if key is not None and key in self._cache:
+            return self._cache[key]
+        ls = linear_solver(build(), self.comm, self.solver)
+        self.count += 1
+        if key is None:
+            self._drop(None)
+        elif len(self._cache) >= self.keep:
+            self._drop(next(iter(self._cache)))
+        self._cache[key] = ls
+        return ls
+
+    def _drop(self, key) -> None:
+        old = self._cache.pop(key, None)
+        if old is not None:
+            old.destroy()
+
+    def destroy(self) -> None:
+        for ls in self._cache.values():
+            ls.destroy()
+        self._cache.clear()

@@ -34,15 +34,18 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from .boundary import boundary_quadrature, collocation
+from .boundary import Collocation, boundary_quadrature, collocation
 from .elasticity import ElasticMaterial
 from .errors import InputError
-from .linear_solver import linear_solver
 from .nodal_domains import NodalDomains, nodal_domains
 from .operators import laplacian, mass, stiffness
 from .particles import Particles
 from .quadrature import Quadrature, dni, mscni_stabilization, scni, smoothed_gradients
 from .shape_functions import RKApproximation, evaluate, rk_approximation
+from .solvers.fields import layout
+from .solvers.integrate import integrate, time_grid  # noqa: F401  (time_grid: part of this module's API)
+from .solvers.model import Constraints, Stateless
+from .solvers.newmark import backward_euler
 from .sparse_rows import SparseRows, combine_rows
 
 VARIANTS = ("ni", "scni", "ni+fpp", "scni+fpp")
@@ -255,34 +258,91 @@ class BiotSolution:
         return np.stack([(n @ self.U[:, :, c].T).T for c in range(2)], axis=-1)
 
 
-def time_grid(output_times: Sequence[float], first_step: float, growth: float = 1.0,
-              max_step: float = np.inf, hold: int = 1) -> np.ndarray:
-    """Step times 0 = t_0 < t_1 < ... hitting every output time exactly.
+class BiotModel(Stateless):
+    """The u-p equations (3.32)-(3.37) as a model for the steppers (``rkfx.solvers``).
 
-    Steps start at ``first_step`` and grow by ``growth`` every ``hold`` steps (1 = uniform) up
-    to ``max_step``; a step that would pass an output time is shortened to end on it. Holding
-    the step for several steps lets the solver reuse its factorization.
+    Unknowns ``[u (2 n, interleaved), p (n)]``, both of time order 1 (u is quasi-static; its
+    rate enters the storage equation). With C = [[0, 0], [Kup^T, S(dt)]] and
+    r = [Kuu u - Kup p - F^ext(t), Kh p - Q^ext(t)] the model reads C x' + r(x, t) = 0:
+    Kup^T u' + S p' + Kh p = Q^ext. S(dt) is the compressibility plus the rate-form projection
+    stabilization (3.60), whose eps_f (3.53) depends on the step size.
+
+    Attributes:
+        operators: The matrices of one discretization.
+        material: Poroelastic constants.
+        collocation: Collocated essential conditions of u and p.
+        nodes: Node coordinates at which the conditions are collocated, shape ``(n, 2)`` [m].
+        loads: F^ext(t), Q^ext(t) as ``(2 n,)`` and ``(n,)`` arrays.
     """
-    if int(hold) != hold or hold < 1:
-        raise InputError(f"hold = {hold!r} must be a positive integer")
-    out = np.sort(np.asarray(output_times, float))
-    if not first_step > 0:
-        raise InputError(f"first time step {first_step!r} must be positive")
-    if not growth >= 1.0:
-        raise InputError(f"step growth {growth!r} must be >= 1")
-    if out.size == 0 or out[0] <= 0:
-        raise InputError("output times must be positive")
-    t, dt, grid = 0.0, first_step, [0.0]
-    for target in out:
-        while t < target * (1 - 1e-12):
-            step = min(dt, max_step)
-            if t + step > target * (1 - 1e-9) or target - (t + step) < 1e-3 * step:
-                step = target - t
-            t = target if abs(target - (t + step)) <= 1e-12 * target else t + step
-            grid.append(t)
-            if (len(grid) - 1) % hold == 0:
-                dt = min(dt * growth, max_step)
-    return np.array(grid)
+
+    def __init__(self, operators: BiotOperators, material: PoroMaterial, col: Collocation,
+                 nodes: np.ndarray, loads: Callable[[float], tuple[np.ndarray, np.ndarray]]):
+        n = operators.Kh.shape[0]
+        self.layout = layout(("u", 2, 1), ("p", 1, 1), nodes=n)
+        self.linear = True
+        self.operators, self.material, self.collocation, self.loads = operators, material, col, loads
+        self.nodes = nodes
+        o = operators
+        self._K = sp.bmat([[o.Kuu, -o.Kup], [None, o.Kh]], format="csr")
+        self._capacity: dict = {}
+        self._n = n
+
+    def storage(self, dt: float) -> sp.csr_matrix:
+        """Compressibility plus the projection stabilization (3.60) for steps of dt, ``(n, n)``."""
+        o = self.operators
+        return o.Ks + o.stabilization(fpp_parameter(self.material, dt, o.h)) if o.fpp_rows else o.Ks
+
+    def residual(self, x: np.ndarray, t: float) -> np.ndarray:
+        f, q = self.loads(t)
+        return self._K @ x - np.concatenate([f, q])
+
+    def tangent(self, x: np.ndarray, t: float) -> sp.csr_matrix:
+        return self._K
+
+    def mass(self) -> None:
+        return None
+
+    def capacity(self, dt: float) -> sp.csr_matrix:
+        key = round(dt, 12)
+        if key not in self._capacity:
+            if len(self._capacity) > 4:
+                self._capacity.pop(next(iter(self._capacity)))
+            n = self._n
+            self._capacity[key] = sp.bmat([[sp.csr_matrix((2 * n, 2 * n)), None],
+                                           [self.operators.Kup.T, self.storage(dt)]], format="csr")
+        return self._capacity[key]
+
+    def constraints(self, t: float) -> Constraints:
+        return Constraints(self.collocation.G, self.collocation.values(self.nodes, t))
+
+    def equation_weights(self, co) -> np.ndarray:
+        """-1 / (du'/du) on the storage rows: the symmetric saddle-point Jacobian
+        [[Kuu, -Kup], [-Kup^T, -S - theta dt Kh]] of eqs. (3.50)-(3.51)."""
+        n = self._n
+        return np.r_[np.ones(2 * n), np.full(n, -1.0 / co.dv[0])]
+
+
+class _Outputs:
+    """Nodal coefficients kept at the output times."""
+
+    def __init__(self, wanted: np.ndarray, n: int):
+        self.wanted = wanted
+        self.U = np.zeros((len(wanted), n, 2))
+        self.P = np.zeros((len(wanted), n))
+        self.n = n
+
+    def record(self, s) -> None:
+        j = np.flatnonzero(np.abs(self.wanted - s.t) <= 1e-12 * np.maximum(self.wanted, 1.0))
+        for i in j:
+            self.U[i] = s.x[:2 * self.n].reshape(self.n, 2)
+            self.P[i] = s.x[2 * self.n:]
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        return {"U": self.U, "P": self.P}
+
+    def restore(self, arrays) -> None:
+        self.U[...] = arrays["U"]
+        self.P[...] = arrays["P"]
 
 
 def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_times: Sequence[float],
@@ -290,7 +350,9 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
                tractions: Sequence[TotalTraction] = (), fluxes: Sequence[Flux] = (),
                variant: str = "scni+fpp", support_factor: float = 1.5,
                gravity: Sequence[float] | None = None, density: float = 0.0, fluid_density: float = 0.0,
-               comm=None, solver: str = "mumps", progress: Callable | None = None) -> BiotSolution:
+               comm=None, solver: str = "mumps", progress: Callable | None = None,
+               rk: RKApproximation | None = None, domains: NodalDomains | None = None,
+               checkpoint_every: int = 0, checkpoint_dir=None, resume=None) -> BiotSolution:
     """Solve the u-p equations by backward Euler on the step times ``times`` (t_0 = 0).
 
     Initial state u = 0, p = 0. Loads and prescribed values are evaluated at t_{n+1} (3.39)-(3.40).
@@ -310,6 +372,11 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
         fluid_density: rho_f [kg/m^3] (Darcy flux -k (grad p - rho_f g), eq. 3.10).
         comm, solver: Passed to the linear solver (PETSc when installed).
         progress: Optional wrapper of the step iterator (e.g. a progress bar).
+        rk: The RK approximation of u and p (default: linear basis, support
+            ``support_factor`` h_I, no cracks).
+        domains: Nodal domains of the integration (default: median-dual cells of ``p``).
+        checkpoint_every, checkpoint_dir: Write a checkpoint every so many steps.
+        resume: A checkpoint folder to continue from (same particles, material and times).
     """
     t_all = np.asarray(times, float)
     if t_all[0] != 0.0 or np.any(np.diff(t_all) <= 0):
@@ -318,13 +385,13 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
     where = np.searchsorted(t_all, wanted)
     if np.any(where >= len(t_all)) or np.any(np.abs(t_all[np.minimum(where, len(t_all) - 1)] - wanted)
                                              > 1e-12 * np.maximum(wanted, 1.0)):
-        raise InputError("every output time must be one of the step times (use rkfx.poroelasticity.time_grid)")
+        raise InputError("every output time must be one of the step times (use rkfx.solvers.integrate.time_grid)")
     if not (displacements or pressures):
         raise InputError("no essential boundary conditions: prescribe displacements (and pressures)")
     timings = {}
     t0 = time.perf_counter()
-    rk = rk_approximation(p.x, p.spacing, support_factor)
-    d = nodal_domains(p)
+    rk = rk_approximation(p.x, p.spacing, support_factor) if rk is None else rk
+    d = nodal_domains(p) if domains is None else domains
     ops = biot_operators(p, rk, d, material, variant)
     bq = boundary_quadrature(p, d, rk)
     col = collocation(p, rk, [(displacements, 0, 2), (pressures, 2 * p.num_nodes, 1)], 3 * p.num_nodes)
@@ -355,36 +422,10 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
                                                * np.asarray(fl.value(bq.points[sel], t, bq.normals[sel]), float))
         return f.ravel() + f_gravity, q + q_gravity  # F^ext (3.36) and Q^ext (3.37)
 
-    solvers = {}
-    state = np.zeros(3 * n)
-    keep = {float(t): i for i, t in enumerate(wanted)}
-    U = np.zeros((len(wanted), n, 2))
-    P = np.zeros((len(wanted), n))
-    steps = range(1, len(t_all))
-    for s in (progress(steps) if progress else steps):
-        dt = t_all[s] - t_all[s - 1]
-        key = round(dt, 12) if dt > 0 else dt
-        if key not in solvers:
-            if len(solvers) > 4:  # keep a few factorizations (geometric steps change dt each step)
-                solvers.pop(next(iter(solvers)))[0].destroy()
-            # Rate-form storage: compressibility plus the projection stabilization (3.60).
-            storage = ops.Ks + ops.stabilization(fpp_parameter(material, dt, ops.h)) if ops.fpp_rows else ops.Ks
-            jac = sp.bmat([[ops.Kuu, -ops.Kup], [-ops.Kup.T, -storage - dt * ops.Kh]], format="csr")
-            solvers[key] = (linear_solver(sp.bmat([[jac, col.G.T], [col.G, None]], format="csr"), comm, solver),
-                            storage)
-        ls, storage = solvers[key]
-        f, q = loads(t_all[s])
-        u_old, p_old = state[:2 * n], state[2 * n:]
-        rhs = np.concatenate([f, -ops.Kup.T @ u_old - storage @ p_old - dt * q, col.values(p.x, t_all[s])])
-        state = ls.solve(rhs)[:3 * n]
-        i = keep.get(float(t_all[s]))
-        if i is None:
-            j = np.flatnonzero(np.abs(wanted - t_all[s]) <= 1e-12 * np.maximum(wanted, 1.0))
-            i = int(j[0]) if j.size else None
-        if i is not None:
-            U[i] = state[:2 * n].reshape(n, 2)
-            P[i] = state[2 * n:]
-    for ls, _ in solvers.values():
-        ls.destroy()
+    model = BiotModel(ops, material, col, p.x, loads)
+    kept = _Outputs(wanted, n)
+    integrate(backward_euler(), model, t_all, recorder=kept, comm=comm, solver=solver,
+                    progress=progress, max_cuts=0, checkpoint_every=checkpoint_every,
+                    checkpoint_dir=checkpoint_dir, resume=resume)
     timings["steps"] = time.perf_counter() - t0
-    return BiotSolution(rk, wanted, U, P, 3 * n, sum(timings.values()), len(t_all) - 1, timings)
+    return BiotSolution(rk, wanted, kept.U, kept.P, 3 * n, sum(timings.values()), len(t_all) - 1, timings)

@@ -1,0 +1,44 @@
+"""Checkpoint files: named arrays written atomically, so an interrupted run never leaves a
+half-written checkpoint (temporary file, fsync, then ``os.replace``)."""
+import os
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+
+CHECKPOINT = "checkpoint.npz"
+
+
+def save_arrays(directory: str | Path, arrays: Mapping[str, np.ndarray], name: str = CHECKPOINT) -> Path:
+    """Write ``DIR/name`` atomically; returns its path."""
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    target = directory / name
+    tmp = directory / (name + ".tmp")
+    with open(tmp, "wb") as fh:
+        np.savez(fh, **{k: np.asarray(v) for k, v in arrays.items()})
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, target)
+    return target
+
+
+def load_arrays(directory: str | Path, name: str = CHECKPOINT) -> dict[str, np.ndarray]:
+    """The arrays of ``DIR/name``."""
+    path = Path(directory) / name
+    if not path.is_file():
+        raise InputError(f"no checkpoint at {str(path)!r}; run with a checkpoint interval and folder first")
+    with np.load(path) as z:
+        return {k: z[k] for k in z.files}
+
+
+def prefixed(arrays: Mapping[str, np.ndarray], prefix: str) -> dict[str, np.ndarray]:
+    """``arrays`` with every name prefixed (to store several groups in one file)."""
+    return {prefix + k: v for k, v in arrays.items()}
+
+
+def unprefixed(arrays: Mapping[str, np.ndarray], prefix: str) -> dict[str, np.ndarray]:
+    """The group of ``arrays`` stored under ``prefix``, without it."""
+    return {k[len(prefix):]: v for k, v in arrays.items() if k.startswith(prefix)}

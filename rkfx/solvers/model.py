@@ -1,0 +1,112 @@
+"""What a model gives the steppers.
+
+A model is the semi-discrete system
+
+    M x'' + C x' + r(x, t) = 0,   G x = g(t),
+
+over the unknowns of its ``layout`` (``rkfx.solvers.fields``): r = f_int(x) - f_ext(t) is the
+residual (internal minus external forces, and fluxes), K = dr/dx its tangent, M the mass (it
+multiplies the second derivatives of second-order fields), C the capacity (first derivatives;
+it may couple fields, e.g. the storage row alpha div u' of the u-p equations) and G x = g the
+essential conditions, imposed with multipliers. A model with history (damage, crack normals,
+plastic strain, saturation) evaluates it as a *trial* from the committed state in every
+``residual`` call; the steppers ``commit()`` once a step is accepted, so a failed Newton
+iteration or a cut step never touches committed state, and checkpoints save ``state()``.
+
+The steppers only call the methods below; ``rkfx.solvers.newmark`` and
+``rkfx.solvers.quasi_static`` document which they need.
+"""
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+import scipy.sparse as sp
+
+from .fields import FieldLayout
+
+
+@dataclass(frozen=True)
+class Constraints:
+    """Essential conditions G x = g at one time.
+
+    Attributes:
+        G: Constraint rows, shape ``(k, size)`` (collocation rows of the RK transformation
+            method, or unit rows of nodal FEM unknowns).
+        g: Prescribed values, shape ``(k,)``.
+        rate: dg/dt, shape ``(k,)``, or ``None`` (explicit steppers then difference g).
+    """
+
+    G: sp.csr_matrix
+    g: np.ndarray
+    rate: np.ndarray | None = None
+
+    @property
+    def count(self) -> int:
+        return self.G.shape[0]
+
+
+def no_constraints(size: int) -> Constraints:
+    """The empty set of essential conditions for ``size`` unknowns."""
+    return Constraints(sp.csr_matrix((0, size)), np.zeros(0))
+
+
+@runtime_checkable
+class Model(Protocol):
+    """The protocol every model implements (see the module docstring).
+
+    Attributes:
+        layout: The fields and their blocks.
+        linear: True when M, C(dt) and K do not depend on x or t, so a stepper may reuse one
+            factorization per step size and take one Newton iteration per step.
+    """
+
+    layout: FieldLayout
+    linear: bool
+
+    def residual(self, x: np.ndarray, t: float) -> np.ndarray:
+        """r(x, t) = f_int(x) - f_ext(t), shape ``(size,)``, with trial history from ``x``."""
+
+    def tangent(self, x: np.ndarray, t: float) -> sp.spmatrix:
+        """K = dr/dx at the last ``residual`` point, shape ``(size, size)``."""
+
+    def mass(self) -> sp.spmatrix | None:
+        """M, shape ``(size, size)``, or ``None`` (no inertia)."""
+
+    def capacity(self, dt: float) -> sp.spmatrix | None:
+        """C, shape ``(size, size)``, or ``None``; may depend on the step size (stabilization)."""
+
+    def constraints(self, t: float) -> Constraints:
+        """Essential conditions at time t (the rows G must not change with t)."""
+
+    def commit(self) -> None:
+        """Make the trial history of the last ``residual`` call the committed one."""
+
+    def state(self) -> Mapping[str, np.ndarray]:
+        """Committed history arrays, for checkpoints (empty for models without history)."""
+
+    def restore(self, arrays: Mapping[str, np.ndarray]) -> None:
+        """Set the committed history from ``state()`` arrays."""
+
+
+class Stateless:
+    """Mixin for models without history: commit, state and restore do nothing."""
+
+    def commit(self) -> None:
+        pass
+
+    def state(self) -> dict[str, np.ndarray]:
+        return {}
+
+    def restore(self, arrays: Mapping[str, np.ndarray]) -> None:
+        pass
+
+
+def equation_weights(model, coefficients) -> np.ndarray | None:
+    """Row weights a model asks for (``model.equation_weights(coefficients)``), or ``None``.
+
+    A u-p model scales its storage rows by -1 / (dv/dx of u) to make the Jacobian the
+    symmetric saddle-point matrix of eqs. (3.50)-(3.51) and (5.24); the solution is unchanged.
+    """
+    fn = getattr(model, "equation_weights", None)
+    return None if fn is None else fn(coefficients)

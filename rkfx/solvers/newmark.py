@@ -1,0 +1,341 @@
+"""Newmark for second-order fields with the generalized trapezoid for first-order ones.
+
+For the model M x'' + C x' + r(x, t) = 0, G x = g(t) (``rkfx.solvers.model``), a step
+n -> n+1 of size dt predicts, per unknown of a field of time order
+
+* 2:  x~ = x_n + dt v_n + dt^2 (1/2 - beta) a_n,  v~ = v_n + dt (1 - gamma) a_n,
+      a_{n+1} = (x_{n+1} - x~) / (beta dt^2),     v_{n+1} = v~ + gamma dt a_{n+1}
+      (eqs. 5.18-5.20 with the seed's beta_1 = gamma and beta_2 = beta);
+* 1:  x~ = x_n + dt (1 - theta) v_n,               v_{n+1} = (x_{n+1} - x~) / (theta dt)
+      (eqs. 5.21-5.22);
+* 0:  x_{n+1} free, no rates.
+
+and solves M a_{n+1} + C v_{n+1} + r(x_{n+1}, t_{n+1}) = G^T mu with G x_{n+1} = g(t_{n+1})
+by Newton on the corrector w = x_{n+1} - x~. The Jacobian is M/(beta dt^2) + C gamma/(beta dt)
++ K on second-order columns and C/(theta dt) + K on first-order ones.
+
+With beta = 0 or theta = 0 a field is explicit (eqs. 6.37-6.41, beta_2 = 0 and theta = 0):
+x_{n+1} = x~ is known, and the unknown w is a_{n+1} (resp. v_{n+1}), so the step is one
+linear solve with M + gamma dt C (resp. C), lumped or not. Essential conditions on an
+explicit field are met by projecting x~ onto G x = g(t_{n+1}) (weighted by the lumped mass
+or capacity) and imposing G v_{n+1} = g'(t_{n+1}).
+
+Orders of accuracy (asserted in ``tests/test_steppers.py``): 2 for the trapezoidal rule
+(beta = 1/4, gamma = 1/2), central differences (beta = 0, gamma = 1/2) and Crank-Nicolson
+(theta = 1/2); 1 for backward Euler (theta = 1).
+"""
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import InputError
+from ..linear_solver import Factorizations
+from .model import Constraints, Model, equation_weights
+from .newton import NewtonOptions, NewtonResult, newton
+
+
+@dataclass
+class StepState:
+    """The state at a step boundary.
+
+    Attributes:
+        step, t: Step index and time [s].
+        x, v, a: Unknowns and their first and second time derivatives, shape ``(size,)``
+            (v and a are zero where a field's order does not carry them).
+        multipliers: Constraint forces G^T mu of the last step, shape ``(k,)``.
+    """
+
+    step: int
+    t: float
+    x: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    multipliers: np.ndarray
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        return {"step": np.int64(self.step), "t": np.float64(self.t), "x": self.x, "v": self.v, "a": self.a,
+                "multipliers": self.multipliers}
+
+    @classmethod
+    def from_arrays(cls, z) -> "StepState":
+        return cls(int(z["step"]), float(z["t"]), z["x"].copy(), z["v"].copy(), z["a"].copy(),
+                   z["multipliers"].copy())
+
+
+@dataclass(frozen=True)
+class Coefficients:
+    """How the state of step n+1 follows from the corrector w, per unknown.
+
+    x = x~ + dx w, v = v~ + dv w, a = da w.
+
+    Attributes:
+        dt: Step size [s].
+        dx, dv, da: Shape ``(size,)`` each.
+        explicit: Unknowns whose x_{n+1} is the predictor (dx = 0).
+    """
+
+    dt: float
+    dx: np.ndarray
+    dv: np.ndarray
+    da: np.ndarray
+
+    @property
+    def explicit(self) -> np.ndarray:
+        return self.dx == 0.0
+
+
+@dataclass(frozen=True)
+class Newmark:
+    """The Newmark/trapezoid family (see the module docstring).
+
+    Attributes:
+        beta, gamma: Newmark parameters of second-order fields (the seed's beta_2, beta_1);
+            beta = 0 is explicit (central differences with gamma = 1/2).
+        theta: Trapezoid parameter of first-order fields; 1 backward Euler, 1/2
+            Crank-Nicolson, 0 explicit.
+        newton: Newton's settings.
+        rtol, atol: Newton converges when ||F||_inf <= atol + rtol max(||F_0||_inf, s) on
+            the equations, s the largest of ||r||, ||M a||, ||C v|| at the iterate, after at
+            least ``min_iterations``.
+        ctol: ... and ||G x - g||_inf <= ctol (1 + ||g||_inf) on the constraints.
+        min_iterations: Newton iterations before the test is taken (1: never accept the
+            predictor untried).
+    """
+
+    beta: float = 0.25
+    gamma: float = 0.5
+    theta: float = 0.5
+    newton: NewtonOptions = field(default_factory=NewtonOptions)
+    rtol: float = 1e-10
+    atol: float = 0.0
+    ctol: float = 1e-10
+    min_iterations: int = 1
+
+    def __post_init__(self):
+        if not 0.0 <= self.beta <= 0.5:
+            raise InputError(f"Newmark beta = {self.beta!r} must lie in [0, 1/2] (1/4: trapezoidal rule)")
+        if not 0.5 <= self.gamma <= 1.0:
+            raise InputError(f"Newmark gamma = {self.gamma!r} must lie in [1/2, 1] (1/2: second order)")
+        if not 0.0 <= self.theta <= 1.0:
+            raise InputError(f"theta = {self.theta!r} must lie in [0, 1] (1: backward Euler, 1/2: Crank-Nicolson)")
+
+    # ------------------------------------------------------------------ set-up
+
+    def coefficients(self, orders: np.ndarray, dt: float) -> Coefficients:
+        """dx, dv, da of every unknown for a step of size dt."""
+        o2, o1, o0 = orders == 2, orders == 1, orders == 0
+        dx, dv, da = np.zeros(len(orders)), np.zeros(len(orders)), np.zeros(len(orders))
+        if self.beta > 0:
+            dx[o2], dv[o2], da[o2] = 1.0, self.gamma / (self.beta * dt), 1.0 / (self.beta * dt * dt)
+        else:
+            dv[o2], da[o2] = self.gamma * dt, 1.0
+        if self.theta > 0:
+            dx[o1], dv[o1] = 1.0, 1.0 / (self.theta * dt)
+        else:
+            dv[o1] = 1.0
+        dx[o0] = 1.0
+        return Coefficients(dt, dx, dv, da)
+
+    def predict(self, orders: np.ndarray, s: StepState, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """Predictors x~ and v~ of the step from ``s``."""
+        o2, o1 = orders == 2, orders == 1
+        x, v = s.x.copy(), np.zeros_like(s.v)
+        x[o2] += dt * s.v[o2] + dt * dt * (0.5 - self.beta) * s.a[o2]
+        v[o2] = s.v[o2] + dt * (1.0 - self.gamma) * s.a[o2]
+        x[o1] += dt * (1.0 - self.theta) * s.v[o1]
+        return x, v
+
+    def start(self, model: Model, x0: np.ndarray | None = None, v0: np.ndarray | None = None,
+              a0: np.ndarray | None = None, t0: float = 0.0) -> StepState:
+        """The state at t0. Rates default to zero, except that a0 of second-order fields
+        follows from M a0 = -(C v0 + r(x0, t0)) when the model has a mass."""
+        n = model.layout.size
+        x = np.zeros(n) if x0 is None else np.array(x0, float).reshape(n)
+        v = np.zeros(n) if v0 is None else np.array(v0, float).reshape(n)
+        orders = model.layout.orders
+        if a0 is not None:
+            a = np.array(a0, float).reshape(n)
+        else:
+            a = np.zeros(n)
+            m = model.mass()
+            o2 = np.flatnonzero(orders == 2)
+            if m is not None and o2.size:
+                rhs = -model.residual(x, t0)
+                c = model.capacity(1.0)
+                if c is not None:
+                    rhs -= c @ v
+                mm = sp.csr_matrix(m)[o2][:, o2]
+                if mm.nnz == mm.shape[0] and np.all(mm.diagonal() != 0):
+                    a[o2] = rhs[o2] / mm.diagonal()
+                else:
+                    import scipy.sparse.linalg as spla  # noqa: PLC0415
+
+                    a[o2] = spla.spsolve(mm.tocsc(), rhs[o2])
+        k = model.constraints(t0).count
+        return StepState(0, float(t0), x, v, a, np.zeros(k))
+
+    # ------------------------------------------------------------------ one step
+
+    def advance(self, model: Model, s: StepState, dt: float, solves: Factorizations) \
+            -> tuple[StepState | None, NewtonResult]:
+        """Step ``s`` by dt; ``(None, result)`` when Newton fails (the caller cuts dt).
+
+        Trial history is evaluated in the model; the caller commits it once it accepts the
+        step (``rkfx.solvers.integrate``).
+        """
+        if not (np.isfinite(dt) and dt > 0):
+            raise InputError(f"time step dt = {dt!r} must be positive")
+        orders = model.layout.orders
+        t1 = s.t + dt
+        co = self.coefficients(orders, dt)
+        x_t, v_t = self.predict(orders, s, dt)
+        con = model.constraints(t1)
+        system = _NewmarkSystem(self, model, co, x_t, v_t, con, t1, s.t)
+        z0 = np.r_[np.zeros(len(x_t)), s.multipliers if len(s.multipliers) == con.count else np.zeros(con.count)]
+        res = newton(system, z0, solves, self.newton)
+        if not res.converged:
+            return None, res
+        x, v, a = system.state(res.z)
+        return StepState(s.step + 1, t1, x, v, a, res.z[len(x_t):]), res
+
+
+class _NewmarkSystem:
+    """F(w, mu) = [W (M a + C v + r(x, t) - G^T mu), c(w)] of one step."""
+
+    def __init__(self, stepper: Newmark, model: Model, co: Coefficients, x_t, v_t, con: Constraints,
+                 t1: float, t0: float):
+        self.stepper, self.model, self.co, self.t1 = stepper, model, co, t1
+        self.n = len(x_t)
+        self.M, self.C = model.mass(), model.capacity(co.dt)
+        self.G = sp.csr_matrix(con.G)
+        explicit = co.explicit
+        self.linear = bool(model.linear or explicit.all())
+        self.W = equation_weights(model, co)
+        # Rows of G on explicit unknowns constrain the rate; the others the value.
+        on_explicit = (abs(self.G) @ explicit.astype(float)) > 0
+        on_implicit = (abs(self.G) @ (~explicit).astype(float)) > 0
+        if np.any(on_explicit & on_implicit):
+            raise InputError("an essential condition couples explicit and implicit unknowns; "
+                             "constrain each field on its own rows")
+        if on_explicit.any():
+            x_t = _project(x_t, self.G[on_explicit], con.g[on_explicit], self._lumped(explicit))
+            rate = con.rate if con.rate is not None else _rate(model, t0, t1, on_explicit)
+        self.x_t, self.v_t = x_t, v_t
+        scale = np.where(explicit, co.dv, co.dx)
+        self.Gw = (self.G @ sp.diags(scale)).tocsr()
+        self.c0 = self.G @ x_t - con.g
+        if on_explicit.any():
+            self.c0[on_explicit] = (self.G @ v_t)[on_explicit] - np.asarray(rate, float)[on_explicit]
+        self.gscale = 1.0 + (np.abs(con.g).max() if con.count else 0.0)
+        self.r0 = None
+
+    def _lumped(self, explicit) -> np.ndarray:
+        d = np.ones(self.n)
+        for mat, order in ((self.M, 2), (self.C, 1)):
+            if mat is not None:
+                diag = sp.csr_matrix(mat).diagonal()
+                sel = explicit & (self.model.layout.orders == order) & (diag > 0)
+                d[sel] = diag[sel]
+        return d
+
+    def state(self, z):
+        w = z[:self.n]
+        co = self.co
+        return self.x_t + co.dx * w, self.v_t + co.dv * w, co.da * w
+
+    def residual(self, z):
+        x, v, a = self.state(z)
+        r = self.model.residual(x, self.t1)
+        scale = np.abs(r).max() if r.size else 0.0
+        for mat, rate in ((self.M, a), (self.C, v)):
+            if mat is not None:
+                term = mat @ rate
+                scale = max(scale, np.abs(term).max() if term.size else 0.0)
+                r = r + term
+        self.scale = float(scale)
+        mu = z[self.n:]
+        if mu.size:
+            r = r - self.G.T @ mu
+        if self.W is not None:
+            r = self.W * r
+        return np.r_[r, self.c0 + self.Gw @ z[:self.n]]
+
+    def jacobian(self, z):
+        co = self.co
+        x, _, _ = self.state(z)
+        parts = []
+        if (co.dx != 0).any():
+            parts.append(sp.csr_matrix(self.model.tangent(x, self.t1)) @ sp.diags(co.dx))
+        if self.M is not None:
+            parts.append(sp.csr_matrix(self.M) @ sp.diags(co.da))
+        if self.C is not None:
+            parts.append(sp.csr_matrix(self.C) @ sp.diags(co.dv))
+        j = parts[0]
+        for p in parts[1:]:
+            j = j + p
+        gt = -self.G.T
+        if self.W is not None:
+            w = sp.diags(self.W)
+            j, gt = w @ j, w @ gt
+        if self.G.shape[0] == 0:
+            return j.tocsr()
+        return sp.bmat([[j, gt], [self.Gw, None]], format="csr")
+
+    def jacobian_key(self):
+        return ("newmark", round(self.co.dt, 12)) if self.model.linear else None
+
+    def converged(self, z, r, iteration):
+        st = self.stepper
+        if iteration < st.min_iterations:
+            return False
+        eq, con = r[:self.n], r[self.n:]
+        if self.r0 is None:
+            self.r0 = float(np.abs(eq).max()) if eq.size else 0.0
+        # Relative to the start and to the size of the terms at this iterate, so that
+        # round-off in large cancelling forces does not stall a converged solve.
+        ok_eq = (np.abs(eq).max() if eq.size else 0.0) <= st.atol + st.rtol * max(self.r0, self.scale)
+        ok_con = (np.abs(con).max() if con.size else 0.0) <= st.ctol * self.gscale
+        return bool(ok_eq and ok_con)
+
+
+def _project(x: np.ndarray, G: sp.csr_matrix, g: np.ndarray, weight: np.ndarray) -> np.ndarray:
+    """x + W^-1 G^T lambda with G (x + ...) = g: the weighted projection onto the constraints."""
+    import scipy.sparse.linalg as spla  # noqa: PLC0415
+
+    winv_gt = sp.diags(1.0 / weight) @ G.T
+    lam = spla.spsolve(sp.csc_matrix(G @ winv_gt), g - G @ x)
+    return x + winv_gt @ np.atleast_1d(lam)
+
+
+def _rate(model: Model, t0: float, t1: float, rows: np.ndarray) -> np.ndarray:
+    """dg/dt at t1 by the difference over the step (models may give ``Constraints.rate``)."""
+    return (model.constraints(t1).g - model.constraints(t0).g) / (t1 - t0)
+
+
+def theta_method(theta: float, **options) -> Newmark:
+    """The theta-method for first-order models: 1 backward Euler, 1/2 Crank-Nicolson."""
+    return Newmark(theta=theta, **options)
+
+
+def backward_euler(**options) -> Newmark:
+    return theta_method(1.0, **options)
+
+
+def crank_nicolson(**options) -> Newmark:
+    return theta_method(0.5, **options)
+
+
+def trapezoidal(**options) -> Newmark:
+    """Newmark beta = 1/4, gamma = 1/2 with theta = 1/2: the seed's choice (5.18-5.22)."""
+    return Newmark(beta=0.25, gamma=0.5, theta=0.5, **options)
+
+
+def explicit(**options) -> Newmark:
+    """beta = 0, gamma = 1/2, theta = 0: the explicit u-p scheme of eqs. (6.37)-(6.41)."""
+    return Newmark(beta=0.0, gamma=0.5, theta=0.0, **options)
+
+
+def with_newton(stepper: Newmark, **options) -> Newmark:
+    """The stepper with other Newton settings."""
+    return replace(stepper, newton=replace(stepper.newton, **options))

@@ -1,0 +1,184 @@
+"""The steppers on small models with exact solutions: orders of accuracy, constraints,
+Newton's reports, step cutting and bitwise resume."""
+import numpy as np
+import pytest
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+from rkfx.errors import InputError, SolverError
+from rkfx.solvers import newmark as nm
+from rkfx.solvers.fields import single
+from rkfx.solvers.integrate import integrate, time_grid
+from rkfx.solvers.model import Constraints, Stateless, no_constraints
+from rkfx.solvers.newton import DIVERGED, MAX_ITERATIONS, NewtonOptions
+
+
+class Oscillator(Stateless):
+    """m x'' + k x + k3 x^3 = 0 for n uncoupled unknowns (k3 = 0: linear, x = cos(omega t))."""
+
+    def __init__(self, n=1, m=2.0, k=8.0, k3=0.0):
+        self.layout = single("x", 1, 2, n)
+        self.m, self.k, self.k3 = m, k, k3
+        self.linear = k3 == 0.0
+
+    def residual(self, x, t):
+        return self.k * x + self.k3 * x**3
+
+    def tangent(self, x, t):
+        return sp.diags(self.k + 3 * self.k3 * x**2)
+
+    def mass(self):
+        return sp.identity(self.layout.size) * self.m
+
+    def capacity(self, dt):
+        return None
+
+    def constraints(self, t):
+        return no_constraints(self.layout.size)
+
+
+class Diffusion(Stateless):
+    """C x' + K x = 0: three coupled first-order unknowns (a lumped 1-D consolidation), with an
+    optional prescribed x_0(t) = sin(t)."""
+
+    C = np.diag([1.0, 2.0, 1.5])
+    K = np.array([[3.0, -1.0, 0.0], [-1.0, 2.0, -1.0], [0.0, -1.0, 1.0]])
+
+    def __init__(self, prescribed=False):
+        self.layout = single("p", 1, 1, 3)
+        self.linear = True
+        self.prescribed = prescribed
+
+    def residual(self, x, t):
+        return self.K @ x
+
+    def tangent(self, x, t):
+        return sp.csr_matrix(self.K)
+
+    def mass(self):
+        return None
+
+    def capacity(self, dt):
+        return sp.csr_matrix(self.C)
+
+    def constraints(self, t):
+        if not self.prescribed:
+            return no_constraints(3)
+        return Constraints(sp.csr_matrix(([1.0], ([0], [0])), shape=(1, 3)), np.array([np.sin(t)]),
+                           np.array([np.cos(t)]))
+
+
+class Final:
+    def __init__(self):
+        self.x = []
+
+    def record(self, s):
+        self.x.append(s.x.copy())
+
+    def arrays(self):
+        return {"x": np.array(self.x)}
+
+    def restore(self, a):
+        self.x = list(a["x"])
+
+
+def run(stepper, model, t_end, steps, x0, v0=None):
+    times = np.linspace(0.0, t_end, steps + 1)
+    s0 = stepper.start(model, x0=x0, v0=v0)
+    return integrate(stepper, model, times, start=s0).state
+
+
+def rates(errors):
+    e = np.asarray(errors)
+    return np.log2(e[:-1] / e[1:])
+
+
+@pytest.mark.parametrize("stepper, order", [(nm.trapezoidal(), 2.0), (nm.explicit(), 2.0),
+                                            (nm.Newmark(beta=0.25, gamma=0.6), 1.0)])
+def test_oscillator_orders(stepper, order):
+    model = Oscillator()
+    omega = np.sqrt(model.k / model.m)
+    errs = [abs(run(stepper, model, 2.0, n, [1.0]).x[0] - np.cos(omega * 2.0)) for n in (80, 160, 320, 640)]
+    r = rates(errs)
+    assert np.all(r > order - 0.15), (errs, r)
+    assert np.all(r < order + 0.5), (errs, r)
+
+
+@pytest.mark.parametrize("theta, order", [(1.0, 1.0), (0.5, 2.0), (0.0, 1.0)])
+def test_first_order_rates(theta, order):
+    model = Diffusion()
+    x0 = np.array([1.0, -0.5, 2.0])
+    exact = sla.expm(-np.linalg.solve(Diffusion.C, Diffusion.K) * 1.0) @ x0
+    v0 = -np.linalg.solve(Diffusion.C, Diffusion.K @ x0)  # consistent rates for theta < 1
+    steps = (80, 160, 320, 640) if theta == 0 else (10, 20, 40, 80)
+    errs = [np.abs(run(nm.theta_method(theta), model, 1.0, n, x0, v0).x - exact).max() for n in steps]
+    r = rates(errs)
+    assert np.all(r > order - 0.1), (errs, r)
+    assert errs[-1] < (1e-4 if order == 2 else 2e-2)
+
+
+@pytest.mark.parametrize("theta", [1.0, 0.5, 0.0])
+def test_prescribed_value_is_met_exactly(theta):
+    model = Diffusion(prescribed=True)
+    v0 = np.array([1.0, 0.0, 0.0])
+    s = run(nm.theta_method(theta), model, 0.7, 35, [0.0, 0.0, 0.0], v0)
+    assert s.x[0] == pytest.approx(np.sin(0.7), abs=1e-12)
+
+
+def test_duffing_trapezoid_second_order():
+    model = Oscillator(k3=20.0)
+    st = nm.trapezoidal(rtol=1e-13)
+    ref = run(st, model, 1.0, 5120, [1.0]).x[0]
+    errs = [abs(run(st, model, 1.0, n, [1.0]).x[0] - ref) for n in (40, 80, 160, 320)]
+    assert np.all(rates(errs) > 1.85), errs
+
+
+def test_linear_model_reuses_one_factorization():
+    model = Diffusion()
+    out = integrate(nm.backward_euler(), model, np.linspace(0, 1, 21),
+                    start=nm.backward_euler().start(model, x0=[1.0, 0.0, 0.0]))
+    assert out.factorizations == 1 and out.newton_iterations == 20
+
+
+class Stiff(Oscillator):
+    """A Duffing spring whose Newton diverges at a large step (k3 huge)."""
+
+    def __init__(self):
+        super().__init__(k3=1e6)
+
+
+def test_step_cutting_and_failure_message():
+    model = Stiff()
+    st = nm.Newmark(newton=NewtonOptions(max_iterations=6))
+    out = integrate(st, model, [0.0, 0.5], start=st.start(model, x0=[1.0]), max_cuts=12)
+    assert out.cuts > 0 and out.state.t == 0.5
+    with pytest.raises(SolverError, match=r"Newton failed at step 1 \(t = .* after 0 cuts\), iteration \d+: "
+                                          rf"({MAX_ITERATIONS}|{DIVERGED}) \(residual"):
+        integrate(st, model, [0.0, 0.5], start=st.start(model, x0=[1.0]), max_cuts=0)
+
+
+def test_resume_is_bitwise(tmp_path):
+    model = Oscillator(n=3, k3=5.0)
+    st = nm.trapezoidal()
+    times = np.linspace(0, 1.0, 41)
+    x0 = [1.0, 0.5, -0.2]
+    full = Final()
+    integrate(st, model, times, start=st.start(model, x0=x0), recorder=full)
+    first = Final()
+    integrate(st, model, times[:25], start=st.start(model, x0=x0), recorder=first, checkpoint_every=8,
+              checkpoint_dir=tmp_path)
+    rest = Final()
+    out = integrate(st, model, times, recorder=rest, resume=tmp_path)
+    assert out.resumed_from == 24
+    assert np.array_equal(np.array(rest.x), np.array(full.x))
+
+
+def test_bad_input_names_the_culprit():
+    with pytest.raises(InputError, match="theta"):
+        nm.Newmark(theta=1.5)
+    with pytest.raises(InputError, match="beta"):
+        nm.Newmark(beta=-1.0)
+    with pytest.raises(InputError, match="increasing"):
+        integrate(nm.trapezoidal(), Oscillator(), [0.0, 0.0])
+    with pytest.raises(InputError, match="output times"):
+        time_grid([0.0], 0.1)
