@@ -53,6 +53,8 @@ class Factorizations:
         self.comm, self.solver, self.keep = comm, solver, int(keep)
         self._cache: dict = {}
         self.count = 0  # factorizations made
+        # Set-up that steppers reuse from step to step of one run (keyed by the stepper).
+        self.memo: dict = {}
 
     def get(self, key, build):
         """The solver for ``key``, factorizing ``build()`` when it is not cached."""

@@ -6,6 +6,7 @@ Strains use Voigt order (eps_xx, eps_yy, gamma_xy).
 import numpy as np
 import scipy.sparse as sp
 
+from .errors import InputError
 from .quadrature import Quadrature
 from .sparse_rows import SparseRows
 
@@ -37,33 +38,67 @@ def block_diagonal(blocks: np.ndarray) -> sp.csr_matrix:
     return sp.csr_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())), shape=(m * r, m * c))
 
 
-def stiffness(quadratures: list[Quadrature], d: np.ndarray) -> sp.csr_matrix:
-    """Elastic stiffness ``sum_q w_q B_q^T D B_q`` (eqs. 3.32 and 3.56), shape ``(2 n, 2 n)``."""
-    return sum(weighted_product(strain_matrix(q.gradients), q.weights, d) for q in quadratures)
+def _per_quadrature(c, quadratures: list[Quadrature]) -> list:
+    """A coefficient for each quadrature: ``c`` itself, or ``c[i]`` when given as a list (one
+    array of point values per quadrature, e.g. per-particle fields mapped to the points)."""
+    if isinstance(c, (list, tuple)):
+        if len(c) != len(quadratures):
+            raise InputError(f"{len(c)} coefficient arrays for {len(quadratures)} quadratures; give one each")
+        return list(c)
+    return [c] * len(quadratures)
 
 
-def laplacian(quadratures: list[Quadrature], k: np.ndarray | float = 1.0) -> sp.csr_matrix:
-    """Diffusion matrix ``sum_q w_q (grad N)^T k grad N`` (eqs. 3.35 and 3.59), shape ``(n, n)``."""
+def stiffness(quadratures: list[Quadrature], d) -> sp.csr_matrix:
+    """Elastic stiffness ``sum_q w_q B_q^T D B_q`` (eqs. 3.32 and 3.56), shape ``(2 n, 2 n)``.
+
+    ``d``: one ``(3, 3)`` matrix [Pa], or a list with a ``(3, 3)`` or ``(m_q, 3, 3)`` array per
+    quadrature (a stiffness per point, e.g. degraded by damage).
+    """
+    return sum(weighted_product(strain_matrix(q.gradients), q.weights, dq)
+               for q, dq in zip(quadratures, _per_quadrature(d, quadratures)))
+
+
+def laplacian(quadratures: list[Quadrature], k=1.0) -> sp.csr_matrix:
+    """Diffusion matrix ``sum_q w_q (grad N)^T k grad N`` (eqs. 3.35 and 3.59), shape ``(n, n)``.
+
+    ``k``: a scalar or ``(2, 2)`` tensor, or a list with a ``(m_q,)`` or ``(m_q, 2, 2)`` array
+    per quadrature (an isotropic or anisotropic permeability per point).
+    """
     total = None
-    for q in quadratures:
+    for q, kq in zip(quadratures, _per_quadrature(k, quadratures)):
         g = q.gradients
         gx, gy = g.matrix(0), g.matrix(1)
-        kk = np.broadcast_to(np.asarray(k, float) * np.eye(2) if np.ndim(k) == 0 else k, (2, 2))
-        w = sp.diags(q.weights)
-        term = (kk[0, 0] * gx.T @ w @ gx + kk[0, 1] * gx.T @ w @ gy + kk[1, 0] * gy.T @ w @ gx
-                + kk[1, 1] * gy.T @ w @ gy)
+        kq = np.asarray(kq, float)
+        m = len(q.weights)
+        if kq.ndim == 0 or kq.shape == (m,):
+            kk = (kq.reshape(-1, 1, 1) if kq.ndim else kq) * np.eye(2)
+        else:
+            kk = kq
+        kk = np.broadcast_to(kk, (m, 2, 2))
+        grads = (gx, gy)
+        term = None
+        for a in range(2):
+            for b in range(2):
+                if not np.any(kk[:, a, b]):
+                    continue
+                part = grads[a].T @ sp.diags(q.weights * kk[:, a, b]) @ grads[b]
+                term = part if term is None else term + part
+        term = term if term is not None else sp.csr_matrix((g.num_cols, g.num_cols))
         total = term if total is None else total + term
     return total.tocsr()
 
 
-def mass(quadratures: list[Quadrature], c: float = 1.0) -> sp.csr_matrix:
-    """``sum_q w_q c N^T N`` over the value rows (eqs. 3.34 and 3.58), shape ``(n, n)``."""
+def mass(quadratures: list[Quadrature], c=1.0) -> sp.csr_matrix:
+    """``sum_q w_q c N^T N`` over the value rows (eqs. 3.34 and 3.58), shape ``(n, n)``.
+
+    ``c``: a scalar, or a list with a ``(m_q,)`` array per quadrature.
+    """
     total = None
-    for q in quadratures:
+    for q, cq in zip(quadratures, _per_quadrature(c, quadratures)):
         if q.values is None:
             continue
         nmat = q.values.matrix()
-        term = nmat.T @ sp.diags(c * q.weights) @ nmat
+        term = nmat.T @ sp.diags(np.asarray(cq, float) * q.weights) @ nmat
         total = term if total is None else total + term
     return total.tocsr()
 

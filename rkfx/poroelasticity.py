@@ -144,27 +144,72 @@ def divergence_matrix(q: Quadrature) -> sp.csr_matrix:
                          shape=(g.num_rows, 2 * g.num_cols))
 
 
+@dataclass(frozen=True)
+class NodalFields:
+    """Material fields that vary from particle to particle (e.g. degraded by damage, eq. 5.3-5.8).
+
+    Nodal integration evaluates the u-p forms at the particles; the MSCNI subcell points
+    take the values of the particle that owns them. Any field left ``None`` is the
+    material's constant.
+
+    Attributes:
+        D: Elasticity per particle, shape ``(n, 3, 3)`` [Pa].
+        k: Mobility per particle, isotropic ``(n,)`` or a tensor ``(n, 2, 2)`` [m^2/(Pa s)].
+        alpha: Biot coefficient per particle, shape ``(n,)`` [-].
+        S: Storage coefficient per particle, shape ``(n,)`` [1/Pa].
+    """
+
+    D: np.ndarray | None = None
+    k: np.ndarray | None = None
+    alpha: np.ndarray | None = None
+    S: np.ndarray | None = None
+
+    def check(self, n: int) -> None:
+        """Raise if a field does not have one value per particle."""
+        for name, shapes in (("D", [(n, 3, 3)]), ("k", [(n,), (n, 2, 2)]), ("alpha", [(n,)]), ("S", [(n,)])):
+            v = getattr(self, name)
+            if v is not None and np.shape(v) not in shapes:
+                raise InputError(f"nodal field {name} has shape {np.shape(v)}; give one value per particle: "
+                                 f"{' or '.join(map(str, shapes))}")
+
+
 def biot_operators(p: Particles, rk: RKApproximation, domains: NodalDomains, material: PoroMaterial,
-                   variant: str = "scni+fpp", eps_p: float = 1.0) -> BiotOperators:
-    """Assemble the u-p operators of one integration variant."""
+                   variant: str = "scni+fpp", eps_p: float = 1.0, fields: NodalFields | None = None) -> BiotOperators:
+    """Assemble the u-p operators of one integration variant.
+
+    Args:
+        p, rk, domains: Particles, their RK approximation and nodal domains.
+        material: Constant poroelastic properties.
+        variant: ``ni``, ``scni``, ``ni+fpp`` or ``scni+fpp``.
+        eps_p: MSCNI stabilization factor of the subcell terms (3.56).
+        fields: Per-particle material fields overriding the constants.
+    """
     if variant not in VARIANTS:
         raise InputError(f"unknown variant {variant!r}; choose one of {', '.join(VARIANTS)}")
     d = domains
+    n = p.num_nodes
+    fields = NodalFields() if fields is None else fields
+    fields.check(n)
     stabilized = variant.startswith("scni")
     if stabilized:
         smoothed = smoothed_gradients(p, rk, d, subcells=True)
         nodal = scni(p, rk, d, smoothed)
         stab = mscni_stabilization(p, rk, d, smoothed, eps_p, with_values=True)
-        quads = [nodal, stab]
+        quads, owners = [nodal, stab], [np.arange(n), d.subcell_node]
     else:
         nodal = dni(p, rk, d)
-        quads = [nodal]
-    kuu = stiffness(quads, material.elastic.D())
+        quads, owners = [nodal], [np.arange(n)]
+
+    def at_points(value, constant):
+        return constant if value is None else [np.asarray(value, float)[o] for o in owners]
+
+    kuu = stiffness(quads, at_points(fields.D, material.elastic.D()))
     # Coupling (3.57): nodal points only.
-    kup = (divergence_matrix(nodal).T @ sp.diags(material.alpha * nodal.weights) @ nodal.values.matrix()).tocsr()
-    n = p.num_nodes
-    ks = mass(quads, material.S) if material.S > 0 else sp.csr_matrix((n, n))
-    kh = laplacian(quads, material.k)
+    alpha = material.alpha if fields.alpha is None else np.asarray(fields.alpha, float)
+    kup = (divergence_matrix(nodal).T @ sp.diags(alpha * nodal.weights) @ nodal.values.matrix()).tocsr()
+    ks = mass(quads, at_points(fields.S, material.S)) if (material.S > 0 or fields.S is not None) \
+        else sp.csr_matrix((n, n))
+    kh = laplacian(quads, at_points(fields.k, material.k))
     rows, weights, nodes = [], [], []
     if variant.endswith("+fpp"):
         # (3.61): Pi N(x_L) = sum_C N(x_hat_C) A_C / A_L, so the cell rows are N(x_L) - Pi N(x_L).
@@ -352,7 +397,8 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
                gravity: Sequence[float] | None = None, density: float = 0.0, fluid_density: float = 0.0,
                comm=None, solver: str = "mumps", progress: Callable | None = None,
                rk: RKApproximation | None = None, domains: NodalDomains | None = None,
-               checkpoint_every: int = 0, checkpoint_dir=None, resume=None) -> BiotSolution:
+               fields: NodalFields | None = None, checkpoint_every: int = 0, checkpoint_dir=None,
+               resume=None) -> BiotSolution:
     """Solve the u-p equations by backward Euler on the step times ``times`` (t_0 = 0).
 
     Initial state u = 0, p = 0. Loads and prescribed values are evaluated at t_{n+1} (3.39)-(3.40).
@@ -375,6 +421,8 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
         rk: The RK approximation of u and p (default: linear basis, support
             ``support_factor`` h_I, no cracks).
         domains: Nodal domains of the integration (default: median-dual cells of ``p``).
+        fields: Per-particle material fields (stiffness, permeability tensor, Biot coefficient,
+            storage) in place of the material's constants.
         checkpoint_every, checkpoint_dir: Write a checkpoint every so many steps.
         resume: A checkpoint folder to continue from (same particles, material and times).
     """
@@ -392,7 +440,7 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
     t0 = time.perf_counter()
     rk = rk_approximation(p.x, p.spacing, support_factor) if rk is None else rk
     d = nodal_domains(p) if domains is None else domains
-    ops = biot_operators(p, rk, d, material, variant)
+    ops = biot_operators(p, rk, d, material, variant, fields=fields)
     bq = boundary_quadrature(p, d, rk)
     col = collocation(p, rk, [(displacements, 0, 2), (pressures, 2 * p.num_nodes, 1)], 3 * p.num_nodes)
     nb = bq.rows.matrix(0)

@@ -5,7 +5,7 @@ import pytest
 from rkfx.errors import InputError
 from rkfx.nodal_domains import nodal_domains
 from rkfx.particles import structured
-from rkfx.poroelasticity import (Displacement, Flux, PoroMaterial, Pressure, biot_operators, fpp_parameter,
+from rkfx.poroelasticity import (Displacement, Flux, NodalFields, PoroMaterial, Pressure, biot_operators, fpp_parameter,
                                  solve_biot, time_grid, zero)
 from rkfx.shape_functions import rk_approximation
 
@@ -86,3 +86,63 @@ def test_a_condition_on_u_y_takes_u_y_from_a_full_vector_value():
     col = collocation(p, rk, [([bc], 0, 2)], 3 * p.num_nodes)
     assert np.all(col.values(p.x, 0.0) == -3.0)
     assert np.all(col.G.indices % 2 == 1)  # only u_y coefficients
+
+
+class _Killed(Exception):
+    pass
+
+
+def _killed_after(count):
+    """A progress wrapper that stops the run after ``count`` steps, as a kill would."""
+    def wrap(steps):
+        for i, s in enumerate(steps):
+            if i == count:
+                raise _Killed
+            yield s
+    return wrap
+
+
+def test_a_killed_run_resumes_to_the_same_result(tmp_path):
+    times = time_grid([2.0e4, 1.0e5], 1.0e3, 1.5, hold=2)
+    top = [Displacement("top", lambda x, t: np.full(len(x), -1e-4 * min(t / 1e4, 1.0)), (1,))]
+    args = (COLUMN, MATERIAL, times, [2.0e4, 1.0e5], FIXED + top, DRAINED_TOP)
+    full = solve_biot(*args)
+    with pytest.raises(_Killed):
+        solve_biot(*args, checkpoint_every=3, checkpoint_dir=tmp_path, progress=_killed_after(7))
+    resumed = solve_biot(*args, checkpoint_every=3, checkpoint_dir=tmp_path, resume=tmp_path)
+    assert np.array_equal(resumed.P, full.P) and np.array_equal(resumed.U, full.U)
+    again = solve_biot(*args, resume=tmp_path)  # the finished run's last checkpoint
+    assert np.array_equal(again.P, full.P)
+    with pytest.raises(InputError, match="same times"):
+        solve_biot(COLUMN, MATERIAL, times * 2, [4.0e4], FIXED + top, DRAINED_TOP, resume=tmp_path)
+
+
+def test_nodal_fields_equal_to_the_constants_change_nothing():
+    rk = rk_approximation(COLUMN.x, COLUMN.spacing, 1.5)
+    d = nodal_domains(COLUMN)
+    n = COLUMN.num_nodes
+    mat = PoroMaterial(E=1.0e6, nu=0.25, k=1.0e-6, alpha=0.8, S=1e-7)
+    fields = NodalFields(D=np.tile(mat.elastic.D(), (n, 1, 1)), k=np.tile(mat.k * np.eye(2), (n, 1, 1)),
+                         alpha=np.full(n, 0.8), S=np.full(n, 1e-7))
+    a = biot_operators(COLUMN, rk, d, mat, "scni+fpp")
+    b = biot_operators(COLUMN, rk, d, mat, "scni+fpp", fields=fields)
+    for name in ("Kuu", "Kup", "Ks", "Kh"):
+        x, y = getattr(a, name), getattr(b, name)
+        assert abs(x - y).max() <= 1e-12 * abs(x).max(), name
+    with pytest.raises(InputError, match="nodal field k has shape"):
+        biot_operators(COLUMN, rk, d, mat, "scni+fpp", fields=NodalFields(k=np.ones(3)))
+
+
+def test_a_permeability_per_particle_layers_the_column():
+    """Two layers, k on top and k/4 below: under a steady inflow v the pressure gradient is
+    four times steeper in the lower layer (series flow). The particles at z = H/2 belong to
+    the top layer, so the layers meet at the lower side of their cells, z_i = H/2 - h/2, and
+    p = v ((H - z_i) / k + 4 z_i / k) at the bottom (within the RK smoothing of the kink)."""
+    v = 1.0e-7
+    k = np.where(COLUMN.x[:, 1] >= H / 2 - 1e-9, MATERIAL.k, MATERIAL.k / 4)
+    z_i = H / 2 - H / 32
+    sol = solve_biot(COLUMN, MATERIAL, LONG, [LONG[-1]], FIXED, DRAINED_TOP, fields=NodalFields(k=k),
+                     fluxes=[Flux("bottom", lambda x, t, n: np.full(len(x), -v))])
+    p = sol.pressure(np.array([[0.5, 0.0], [0.5, 0.75 * H]]))[0]
+    assert p[0] == pytest.approx(v * ((H - z_i) + 4 * z_i) / MATERIAL.k, rel=0.03)
+    assert p[1] == pytest.approx(v * H / 4 / MATERIAL.k, rel=1e-3)

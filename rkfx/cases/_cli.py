@@ -186,6 +186,30 @@ def build_parser(name: str, doc: str | None, specs: Mapping[str, Param],
     return parser
 
 
+@dataclass(frozen=True)
+class Checkpoints:
+    """Where a case's runs keep checkpoints (``--checkpoint-every``, ``--resume``).
+
+    Attributes:
+        every: Checkpoint every so many steps (0: never).
+        work_dir: ``OUT/checkpoints``; each run writes into a folder named after its key.
+        resume: ``DIR/checkpoints`` of an interrupted invocation, or ``None``.
+    """
+
+    every: int = 0
+    work_dir: Path | None = None
+    resume: Path | None = None
+
+    def for_run(self, key: str) -> dict:
+        """``checkpoint_every``, ``checkpoint_dir`` and ``resume`` for the solver of one run: a run
+        that had a checkpoint (finished or not) continues from it, the others start afresh."""
+        folder = key.replace(" ", "_").replace("=", "").replace("/", "-")
+        ck_dir = None if not self.every or self.work_dir is None else Path(self.work_dir) / folder
+        old = None if self.resume is None else Path(self.resume) / folder
+        return {"checkpoint_every": self.every, "checkpoint_dir": ck_dir,
+                "resume": old if old is not None and (old / "checkpoint.npz").is_file() else None}
+
+
 def _fmt_value(v):
     return ",".join(map(str, v)) if isinstance(v, (list, tuple)) else str(v)
 

@@ -36,6 +36,11 @@ S [1/Pa], Lx [m], Ly [m], F [N/m], nx, ny, dt_D [-], growth [-], t_D (list), var
 early_variants (list), fem (list), support_factor [-].
 
     python -m rkfx.cases.mandel [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
+        [--checkpoint-every N] [--resume DIR]
+
+With ``--checkpoint-every N`` every RKPM run writes its state every N steps (and at its end) to
+OUT/checkpoints/; ``--resume DIR`` continues a killed invocation from DIR/checkpoints/, finished
+runs returning their results at once.
 """
 import sys
 from collections.abc import Sequence
@@ -101,12 +106,12 @@ def _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F):
         raise InputError("F = 0: the problem has no load")
 
 
-def _rkpm(p, material, exact, times, outputs, variant, support_factor, desc):
+def _rkpm(p, material, exact, times, outputs, variant, support_factor, desc, io):
     bcs_u = [Displacement("left", zero, (0,)), Displacement("bottom", zero, (1,)),
              Displacement("top", lambda x, t: np.full(len(x), exact.plate_displacement(t)), (1,))]
     bcs_p = [Pressure("right", lambda x, t: np.zeros(len(x)))]
     sol = solve_biot(p, material, times, outputs, bcs_u, bcs_p, variant=variant, support_factor=support_factor,
-                     progress=lambda it: _cli.progress(it, desc, len(times) - 1))
+                     progress=lambda it: _cli.progress(it, desc, len(times) - 1), **io)
     return sol, sol.pressure, sol.wall_time_s, sol.n_dofs
 
 
@@ -126,7 +131,8 @@ def _fem(xs, ys, material, exact, times, outputs, element, samples):
 
 def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, alpha=1.0, S=0.0, Lx=20.0,
         Ly=2.0, F=40.0, nx=101, ny=11, dt_D=0.01, growth=1.6, t_D=(0.01, 0.1, 0.5, 1.0),
-        variants=("scni+fpp", "ni"), early_variants=VARIANTS, fem=FEM_ELEMENTS, support_factor=1.5) -> Results:
+        variants=("scni+fpp", "ni"), early_variants=VARIANTS, fem=FEM_ELEMENTS, support_factor=1.5,
+        checkpoint_every=0, work_dir=None, resume=None) -> Results:
     """Both studies for every requested method; see the module docstring."""
     _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F)
     material = PoroMaterial(E, nu, k, alpha, S)
@@ -145,22 +151,23 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, 
                   t_D=list(t_D), variants=list(variants), early_variants=list(early_variants), fem=list(fem),
                   support_factor=support_factor, c=c, p0=p0, h=h, steps=len(times) - 1)
     results = Results(NAME, params)
+    ck = _cli.Checkpoints(checkpoint_every, work_dir, resume)
     solvers = []
     if "rkpm" in methods:
         for v in dict.fromkeys(list(variants) + list(early_variants)):
             solvers.append((f"rkpm-{v}", v in variants, v in early_variants,
-                            lambda tt, out, v=v: _rkpm(particles, material, exact, tt, out, v, support_factor,
-                                                       f"rkpm {v}")))
+                            lambda tt, out, key, v=v: _rkpm(particles, material, exact, tt, out, v, support_factor,
+                                                            f"rkpm {v}", ck.for_run(key))))
     if "fem" in methods:
         for e in fem:
-            def fem_solve(tt, out, e=e):
+            def fem_solve(tt, out, key, e=e):
                 pp, wall, dofs = _fem(xs, ys, material, exact, tt, out, e, samples)
                 return None, (lambda pts, pp=pp: pp), wall, dofs
             solvers.append((f"fem-{e}", True, True, fem_solve))
     for label, profiles, early, solve in solvers:
         run_ = Run(label, 0.0, 0, series={"x": x}, info={"nodes": nx * ny})
         if profiles:
-            _, sample, wall, dofs = solve(times, times[1:])
+            _, sample, wall, dofs = solve(times, times[1:], f"{label}-profiles")
             p_all = sample(samples)
             keep = np.searchsorted(times[1:], t_out)
             p_h = p_all[keep]
@@ -173,7 +180,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, 
         if early:
             for dtd, nsteps in EARLY:
                 tt = dtd * h**2 / c * np.arange(nsteps + 1)
-                _, sample, wall, dofs = solve(tt, tt[-1:])
+                _, sample, wall, dofs = solve(tt, tt[-1:], f"{label}-early-dtD{dtd:g}")
                 ph = sample(samples)[0]
                 pe = exact.pressure(x, tt[-1])
                 tag = f"early_dtD{dtd:g}"
@@ -259,7 +266,7 @@ def plot(results: Results, out: Path) -> list[Path]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point (see the module docstring)."""
-    return _cli.main(NAME, __doc__, PARAMS, run, plot, argv, QUICK)
+    return _cli.main(NAME, __doc__, PARAMS, run, plot, argv, QUICK, checkpoints=True)
 
 
 if __name__ == "__main__":

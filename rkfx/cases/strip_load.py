@@ -32,6 +32,11 @@ t_D_profile [-], t_D_end [-], depth_history [m], steps_low, variants (list), low
 (list), fem (list), support_factor [-].
 
     python -m rkfx.cases.strip_load [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
+        [--checkpoint-every N] [--resume DIR]
+
+With ``--checkpoint-every N`` every RKPM run writes its state every N steps (and at its end) to
+OUT/checkpoints/; ``--resume DIR`` continues a killed invocation from DIR/checkpoints/, finished
+runs returning their results at once.
 """
 import sys
 from collections.abc import Sequence
@@ -112,7 +117,7 @@ def _check(nx, ny, dt_D, t_D_profile, t_D_end, extent, b, q, steps_low, variants
         raise InputError(f"nx = {nx}, ny = {ny}: need nx >= {STRIP_INTERVALS + 3} and ny >= 4")
 
 
-def _solve(method, xs, ys, material, q, b, times, outputs, samples, drained, support_factor):
+def _solve(method, xs, ys, material, q, b, times, outputs, samples, drained, support_factor, io):
     """Pressure (k, m) and displacement (k, m, 2) at the samples, wall time, unknowns."""
     if method.startswith("rkpm-"):
         p = graded(xs, ys)
@@ -122,7 +127,7 @@ def _solve(method, xs, ys, material, q, b, times, outputs, samples, drained, sup
                                         Displacement("right", zero, (0,))],
                          pressures=[Pressure("top", lambda x, t: np.zeros(len(x)))] if drained else [],
                          tractions=[load], variant=method[5:], support_factor=support_factor,
-                         progress=lambda it: _cli.progress(it, method, len(times) - 1))
+                         progress=lambda it: _cli.progress(it, method, len(times) - 1), **io)
         return sol.pressure(samples), sol.displacement(samples), sol.wall_time_s, sol.n_dofs
     import dolfinx_solver  # noqa: F401, PLC0415
 
@@ -144,8 +149,9 @@ def _solve(method, xs, ys, material, q, b, times, outputs, samples, drained, sup
 def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.0, k=5.0e-8 / 9.8e3, k_low=5.0e-13 / 9.8e3,
         q=1.0e4, b=0.2, extent=25.0, nx=31, ny=31, dt_D=0.025, t_D_profile=0.1, t_D_end=2.0, depth_history=0.2,
         steps_low=4, variants=("scni+fpp", "ni"), low_variants=("ni", "scni+fpp"), fem=("taylor-hood", "q1q1-fpp"),
-        support_factor=1.5) -> Results:
+        support_factor=1.5, checkpoint_every=0, work_dir=None, resume=None) -> Results:
     """Both studies for every requested method; see the module docstring."""
+    ck = _cli.Checkpoints(checkpoint_every, work_dir, resume)
     _check(nx, ny, dt_D, t_D_profile, t_D_end, extent, b, q, steps_low, variants, low_variants, fem)
     length = extent * b
     first = b / STRIP_INTERVALS
@@ -174,7 +180,8 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.0, k=5.0e-8 /
               ([f"fem-{e}" for e in fem] if "fem" in methods else [])
     i_prof = int(np.searchsorted(t_hist, t_prof))
     for label in drained:
-        p_h, _, wall, dofs = _solve(label, xs, ys, material, q, b, times, t_hist, samples, True, support_factor)
+        p_h, _, wall, dofs = _solve(label, xs, ys, material, q, b, times, t_hist, samples, True, support_factor,
+                                    ck.for_run(label))
         prof, histp = p_h[i_prof, :-1], p_h[:, -1]
         results.runs.append(Run(
             label, wall, dofs,
@@ -191,7 +198,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.0, k=5.0e-8 /
     low_methods = [f"rkpm-{v}" for v in low_variants] if "rkpm" in methods else []
     for label in low_methods:
         p_h, u_h, wall, dofs = _solve(label, xs, ys, low, q, b, t_low, t_low[-1:], field_pts, False,
-                                      support_factor)
+                                      support_factor, ck.for_run(f"{label}-low-permeability"))
         pf = p_h[0].reshape(gx.shape)
         # Checkerboard measure: mean |second difference| of p between neighbouring nodes, over q.
         jump = (np.abs(np.diff(pf, 2, axis=0)).mean() + np.abs(np.diff(pf, 2, axis=1)).mean()) / (2 * q)
@@ -267,7 +274,7 @@ def plot(results: Results, out: Path) -> list[Path]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point (see the module docstring)."""
-    return _cli.main(NAME, __doc__, PARAMS, run, plot, argv, QUICK)
+    return _cli.main(NAME, __doc__, PARAMS, run, plot, argv, QUICK, checkpoints=True)
 
 
 if __name__ == "__main__":

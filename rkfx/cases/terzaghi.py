@@ -33,6 +33,11 @@ S [1/Pa], W [m], H [m], q [Pa], nx, ny, dt [s], t_end [s], t_out (list [s]), gro
 variants (list), fem (list), refine_ny (list), support_factor [-].
 
     python -m rkfx.cases.terzaghi [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
+        [--checkpoint-every N] [--resume DIR]
+
+With ``--checkpoint-every N`` every RKPM run writes its state every N steps (and at its end) to
+OUT/checkpoints/; ``--resume DIR`` continues a killed invocation from DIR/checkpoints/, finished
+runs returning their results at once.
 """
 import sys
 from collections.abc import Sequence
@@ -100,7 +105,7 @@ def _check(W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny):
             raise InputError(f"unknown FEM element {e!r}; choose from {', '.join(FEM_ELEMENTS)}")
 
 
-def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_factor):
+def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_factor, io):
     """Pressure at the samples for each output time, wall time and unknowns."""
     if method.startswith("rkpm-"):
         p = structured(W, H, nx, ny)
@@ -110,7 +115,7 @@ def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_f
                          pressures=[Pressure("top", lambda x, t: np.zeros(len(x)))],
                          tractions=[TotalTraction("top", lambda x, t, n: np.tile([0.0, -q], (len(x), 1)))],
                          variant=method[5:], support_factor=support_factor,
-                         progress=lambda it: _cli.progress(it, method, len(times) - 1))
+                         progress=lambda it: _cli.progress(it, method, len(times) - 1), **io)
         return sol.pressure(samples), sol.wall_time_s, sol.n_dofs
     import dolfinx_solver  # noqa: F401, PLC0415
 
@@ -128,10 +133,11 @@ def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_f
 
 def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e3, nu=0.0, k=1.0e-9, alpha=1.0, S=0.0, W=3.0, H=10.0,
         q=1.0e3, nx=7, ny=21, dt=1.0, t_end=1.0, t_out=(), growth=1.5, variants=VARIANTS, fem=FEM_ELEMENTS,
-        refine_ny=(21, 41, 81), support_factor=1.5) -> Results:
+        refine_ny=(21, 41, 81), support_factor=1.5, checkpoint_every=0, work_dir=None, resume=None) -> Results:
     """Both studies for every requested method; see the module docstring."""
     _check(W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny)
     material = PoroMaterial(E, nu, k, alpha, S)
+    ck = _cli.Checkpoints(checkpoint_every, work_dir, resume)
     exact = Terzaghi(E, nu, k, H, q, alpha, S)
     p0 = exact.p0
     outputs = np.unique(np.r_[dt, np.asarray(t_out, float), t_end])
@@ -150,7 +156,8 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e3, nu=0.0, k=1.0e-9, 
                                  refine_ny=list(refine_ny), support_factor=support_factor, p0=p0, c_v=exact.c_v,
                                  steps=len(times) - 1))
     for label in labels:
-        p_h, wall, dofs = _solve(label, W, H, nx, ny, material, q, times, outputs, samples, support_factor)
+        p_h, wall, dofs = _solve(label, W, H, nx, ny, material, q, times, outputs, samples, support_factor,
+                                 ck.for_run(label))
         first = p_h[0] / p0
         errors = {"first_step_max_dev_away": float(np.abs(first - p_exact[0] / p0)[away].max()),
                   "first_step_overshoot": float(first.max() - 1.0),
@@ -165,7 +172,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e3, nu=0.0, k=1.0e-9, 
         for n in refine_ny:
             mx = max(3, int(round((nx - 1) * (n - 1) / (ny - 1))) + 1)
             p_h, wall, dofs = _solve(label, W, H, mx, n, material, q, np.array([0.0, dt]), [dt], samples,
-                                     support_factor)
+                                     support_factor, ck.for_run(f"{label}-ny{n}"))
             results.runs.append(Run(f"{label} ny={n}", wall, dofs,
                                     series={"z": z, "t": [dt], "p": p_h, "p_exact": p_exact[:1]},
                                     errors={"first_step_l2": float(np.linalg.norm(p_h[0] - p_exact[0])
@@ -246,7 +253,7 @@ def plot(results: Results, out: Path) -> list[Path]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point (see the module docstring)."""
-    return _cli.main(NAME, __doc__, PARAMS, run, plot, argv, QUICK)
+    return _cli.main(NAME, __doc__, PARAMS, run, plot, argv, QUICK, checkpoints=True)
 
 
 if __name__ == "__main__":

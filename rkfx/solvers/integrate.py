@@ -107,7 +107,8 @@ def integrate(stepper: Newmark, model: Model, times: Sequence[float], *, start: 
         solves: Factorizations to use (default: new ones on ``comm`` with ``solver``, freed
             at the end).
         max_cuts: Halvings of a failing interval before the run stops with an error.
-        checkpoint_every: Write a checkpoint every so many grid steps (0: never).
+        checkpoint_every: Write a checkpoint every so many grid steps and at the last one
+            (0: never), so that resuming a finished run returns its result at once.
         checkpoint_dir: Folder of the checkpoint.
         resume: A checkpoint folder to continue from.
         progress: Optional wrapper of the step iterator (a progress bar).
@@ -174,7 +175,7 @@ def integrate(stepper: Newmark, model: Model, times: Sequence[float], *, start: 
                 s = new
             if recorder is not None:
                 recorder.record(s)
-            if checkpoint_every and k % checkpoint_every == 0:
+            if checkpoint_every and (k % checkpoint_every == 0 or k == len(t_all) - 1):
                 arrays = prefixed(s.arrays(), "state__") | prefixed(model.state(), "model__")
                 if recorder is not None:
                     arrays |= prefixed(recorder.arrays(), "kept__")

@@ -188,10 +188,14 @@ class Newmark:
             raise InputError(f"time step dt = {dt!r} must be positive")
         orders = model.layout.orders
         t1 = s.t + dt
-        co = self.coefficients(orders, dt)
         x_t, v_t = self.predict(orders, s, dt)
         con = model.constraints(t1)
-        system = _NewmarkSystem(self, model, co, x_t, v_t, con, t1, s.t)
+        key = ("newmark-plan", id(model))
+        plan = solves.memo.get(key)
+        if plan is None:
+            plan = solves.memo[key] = _Plan(self, model, dt, con.G)
+        co = self.coefficients(orders, dt)
+        system = _NewmarkSystem(self, model, plan, co, x_t, v_t, con, t1, s.t)
         z0 = np.r_[np.zeros(len(x_t)), s.multipliers if len(s.multipliers) == con.count else np.zeros(con.count)]
         res = newton(system, z0, solves, self.newton)
         if not res.converged:
@@ -200,44 +204,66 @@ class Newmark:
         return StepState(s.step + 1, t1, x, v, a, res.z[len(x_t):]), res
 
 
+class _Plan:
+    """What the steps of one run share: the constraint rows (fixed in time), which of them
+    act on explicit unknowns, and the projection weights."""
+
+    def __init__(self, stepper: "Newmark", model: Model, dt: float, G: sp.spmatrix):
+        co = stepper.coefficients(model.layout.orders, dt)
+        self.G = sp.csr_matrix(G)
+        self.GT = self.G.T.tocsr()
+        self.explicit = explicit = co.explicit  # the same for every dt
+        self.linear = bool(model.linear or explicit.all())
+        # Rows of G on explicit unknowns constrain the rate; the others the value.
+        self.on_explicit = (abs(self.G) @ explicit.astype(float)) > 0
+        on_implicit = (abs(self.G) @ (~explicit).astype(float)) > 0
+        if np.any(self.on_explicit & on_implicit):
+            raise InputError("an essential condition couples explicit and implicit unknowns; "
+                             "constrain each field on its own rows")
+        self.any_explicit = bool(self.on_explicit.any())
+        self.G_implicit = self.G  # dx = 1 on implicit unknowns
+        self.lumped = _lumped(model.mass(), model.capacity(dt), model.layout.orders, explicit) \
+            if self.any_explicit else None
+
+    def scaled_rows(self, co: Coefficients) -> sp.csr_matrix:
+        """G diag(dx) on value rows, G diag(dv) on rate rows."""
+        if not self.any_explicit:
+            return self.G_implicit
+        return (self.G @ sp.diags(np.where(self.explicit, co.dv, co.dx))).tocsr()
+
+
+def _lumped(M, C, orders: np.ndarray, explicit: np.ndarray) -> np.ndarray:
+    """Diagonal weights of the projection of explicit predictors: lumped mass or capacity."""
+    d = np.ones(len(orders))
+    for mat, order in ((M, 2), (C, 1)):
+        if mat is not None:
+            diag = sp.csr_matrix(mat).diagonal()
+            sel = explicit & (orders == order) & (diag > 0)
+            d[sel] = diag[sel]
+    return d
+
+
 class _NewmarkSystem:
     """F(w, mu) = [W (M a + C v + r(x, t) - G^T mu), c(w)] of one step."""
 
-    def __init__(self, stepper: Newmark, model: Model, co: Coefficients, x_t, v_t, con: Constraints,
-                 t1: float, t0: float):
-        self.stepper, self.model, self.co, self.t1 = stepper, model, co, t1
+    def __init__(self, stepper: "Newmark", model: Model, plan: _Plan, co: Coefficients, x_t, v_t,
+                 con: Constraints, t1: float, t0: float):
+        self.stepper, self.model, self.plan, self.co, self.t1 = stepper, model, plan, co, t1
         self.n = len(x_t)
         self.M, self.C = model.mass(), model.capacity(co.dt)
-        self.G = sp.csr_matrix(con.G)
-        explicit = co.explicit
-        self.linear = bool(model.linear or explicit.all())
+        self.G, self.Gw = plan.G, plan.scaled_rows(co)
         self.W = equation_weights(model, co)
-        # Rows of G on explicit unknowns constrain the rate; the others the value.
-        on_explicit = (abs(self.G) @ explicit.astype(float)) > 0
-        on_implicit = (abs(self.G) @ (~explicit).astype(float)) > 0
-        if np.any(on_explicit & on_implicit):
-            raise InputError("an essential condition couples explicit and implicit unknowns; "
-                             "constrain each field on its own rows")
+        self.linear = plan.linear
+        on_explicit = plan.on_explicit
         if on_explicit.any():
-            x_t = _project(x_t, self.G[on_explicit], con.g[on_explicit], self._lumped(explicit))
+            x_t = _project(x_t, self.G[on_explicit], con.g[on_explicit], plan.lumped)
             rate = con.rate if con.rate is not None else _rate(model, t0, t1, on_explicit)
         self.x_t, self.v_t = x_t, v_t
-        scale = np.where(explicit, co.dv, co.dx)
-        self.Gw = (self.G @ sp.diags(scale)).tocsr()
         self.c0 = self.G @ x_t - con.g
         if on_explicit.any():
             self.c0[on_explicit] = (self.G @ v_t)[on_explicit] - np.asarray(rate, float)[on_explicit]
         self.gscale = 1.0 + (np.abs(con.g).max() if con.count else 0.0)
         self.r0 = None
-
-    def _lumped(self, explicit) -> np.ndarray:
-        d = np.ones(self.n)
-        for mat, order in ((self.M, 2), (self.C, 1)):
-            if mat is not None:
-                diag = sp.csr_matrix(mat).diagonal()
-                sel = explicit & (self.model.layout.orders == order) & (diag > 0)
-                d[sel] = diag[sel]
-        return d
 
     def state(self, z):
         w = z[:self.n]
@@ -256,7 +282,7 @@ class _NewmarkSystem:
         self.scale = float(scale)
         mu = z[self.n:]
         if mu.size:
-            r = r - self.G.T @ mu
+            r = r - self.plan.GT @ mu
         if self.W is not None:
             r = self.W * r
         return np.r_[r, self.c0 + self.Gw @ z[:self.n]]
@@ -264,20 +290,16 @@ class _NewmarkSystem:
     def jacobian(self, z):
         co = self.co
         x, _, _ = self.state(z)
-        parts = []
-        if (co.dx != 0).any():
-            parts.append(sp.csr_matrix(self.model.tangent(x, self.t1)) @ sp.diags(co.dx))
-        if self.M is not None:
-            parts.append(sp.csr_matrix(self.M) @ sp.diags(co.da))
-        if self.C is not None:
-            parts.append(sp.csr_matrix(self.C) @ sp.diags(co.dv))
-        j = parts[0]
-        for p in parts[1:]:
-            j = j + p
-        gt = -self.G.T
+        j = None
+        for mat, scale in ((self.model.tangent(x, self.t1) if (co.dx != 0).any() else None, co.dx),
+                           (self.M, co.da), (self.C, co.dv)):
+            if mat is None or not scale.any():
+                continue
+            term = _scale_columns(sp.csr_matrix(mat), scale)
+            j = term if j is None else j + term
+        gt = -self.plan.GT
         if self.W is not None:
-            w = sp.diags(self.W)
-            j, gt = w @ j, w @ gt
+            j, gt = _scale_rows(j, self.W), _scale_rows(gt, self.W)
         if self.G.shape[0] == 0:
             return j.tocsr()
         return sp.bmat([[j, gt], [self.Gw, None]], format="csr")
@@ -297,6 +319,20 @@ class _NewmarkSystem:
         ok_eq = (np.abs(eq).max() if eq.size else 0.0) <= st.atol + st.rtol * max(self.r0, self.scale)
         ok_con = (np.abs(con).max() if con.size else 0.0) <= st.ctol * self.gscale
         return bool(ok_eq and ok_con)
+
+
+def _scale_columns(a: sp.csr_matrix, scale: np.ndarray) -> sp.csr_matrix:
+    """a diag(scale), as a copy (a scalar multiple when the scale is uniform)."""
+    if np.all(scale == scale[0]):
+        return a * scale[0] if scale[0] != 1.0 else a
+    return a @ sp.diags(scale)
+
+
+def _scale_rows(a: sp.spmatrix, scale: np.ndarray) -> sp.csr_matrix:
+    """diag(scale) a, as a copy."""
+    a = sp.csr_matrix(a, copy=True)
+    a.data *= np.repeat(scale, np.diff(a.indptr))
+    return a
 
 
 def _project(x: np.ndarray, G: sp.csr_matrix, g: np.ndarray, weight: np.ndarray) -> np.ndarray:
