@@ -104,6 +104,7 @@ class LinearSolver:
         self.rhs = self.mat.createVecLeft()
         self.x = self.mat.createVecRight()
         self.residual = self.mat.createVecLeft()
+        self._norm = self.mat.norm(PETSc.NormType.NORM_INFINITY)
         self._warned = False
 
     def solve(self, b: np.ndarray) -> np.ndarray:
@@ -123,12 +124,16 @@ class LinearSolver:
                                  "boundary conditions")
         self.mat.mult(self.x, self.residual)
         self.residual.axpy(-1.0, self.rhs)
-        scale = max(self.rhs.norm(), 1e-300)
-        if self.residual.norm() > 1e-6 * scale:
+        # Normwise backward error ||A x - b|| / (||A|| ||x|| + ||b||): independent of whether b
+        # is a whole right-hand side or a Newton residual of a nearly converged state.
+        inf = PETSc.NormType.NORM_INFINITY
+        scale = max(self._norm * self.x.norm(inf) + self.rhs.norm(inf), 1e-300)
+        error = self.residual.norm(inf) / scale
+        if error > 1e-6:
             what = f"singular ({null_pivots} null pivots)" if null_pivots else "singular or ill-conditioned"
-            raise SolverDiverged(f"PETSc solver {self.solver!r} left a relative residual of "
-                                 f"{self.residual.norm() / scale:.2e}: the system is {what}; check that the "
-                                 "essential boundary conditions remove all rigid-body modes")
+            raise SolverDiverged(f"PETSc solver {self.solver!r} left a backward error of {error:.2e}: the system "
+                                 f"is {what}; check that the essential boundary conditions remove all rigid-body "
+                                 "modes")
         if null_pivots and not self._warned:
             # Consistent but nearly singular, e.g. the spurious modes of direct nodal integration.
             warnings.warn(f"system matrix has {null_pivots} null pivot(s) (nearly singular); the solution "
