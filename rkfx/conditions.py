@@ -1,0 +1,146 @@
+"""Boundary conditions: one vocabulary for every model, RKPM and FEM alike.
+
+A condition names a boundary part and a value. The part is the name of a tagged boundary
+(``"left"``, a gmsh physical group) or a marker ``marker(x) -> bool (m,)``. The value is a
+number, a constant vector, or a function: ``value(x, t)`` for essential conditions and
+``value(x, t, n)`` for tractions and fluxes, with x and the outward normals n of shape
+``(m, gdim)`` [m] and t [s]. ``values(condition, x, t, n)`` evaluates any of them to an array with
+one row per point and one column per prescribed component.
+
+Essential: ``Displacement`` (and ``Velocity`` for explicit dynamics, e.g. an impact),
+``Pressure``. Natural: ``Traction`` (total traction (sigma'' - alpha p I) n in u-p models),
+``Flux`` (outward normal fluid flux q . n).
+"""
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .errors import InputError
+
+Boundary = str | Callable[[np.ndarray], np.ndarray]
+Value = float | Sequence[float] | np.ndarray | Callable[..., Any]
+
+
+@dataclass(frozen=True)
+class Displacement:
+    """u_c = value for the listed components c on a boundary part [m].
+
+    ``value(x, t)`` may return every component ``(m, gdim)``, the prescribed ones
+    ``(m, len(components))``, or ``(m,)`` for one component.
+    """
+
+    boundary: Boundary
+    value: Value = 0.0
+    components: tuple[int, ...] = (0, 1)
+
+    def __post_init__(self):
+        _check_components(self)
+
+
+@dataclass(frozen=True)
+class Velocity:
+    """du_c/dt = value for the listed components c on a boundary part [m/s] (explicit dynamics)."""
+
+    boundary: Boundary
+    value: Value = 0.0
+    components: tuple[int, ...] = (0, 1)
+
+    def __post_init__(self):
+        _check_components(self)
+
+
+@dataclass(frozen=True)
+class Pressure:
+    """p = value on a boundary part (drained when 0) [Pa]."""
+
+    boundary: Boundary
+    value: Value = 0.0
+    components: tuple[int, ...] = (0,)
+
+
+@dataclass(frozen=True)
+class Traction:
+    """Traction t = value (total traction in u-p models) on a boundary part [Pa]."""
+
+    boundary: Boundary
+    value: Value
+    components: tuple[int, ...] = (0, 1)
+
+    def __post_init__(self):
+        _check_components(self)
+
+
+@dataclass(frozen=True)
+class Flux:
+    """Outward normal fluid flux q . n = value on a boundary part [m/s]."""
+
+    boundary: Boundary
+    value: Value
+    components: tuple[int, ...] = (0,)
+
+
+Condition = Displacement | Velocity | Pressure | Traction | Flux
+ESSENTIAL = (Displacement, Velocity, Pressure)
+NATURAL = (Traction, Flux)
+
+
+def _check_components(c) -> None:
+    comps = tuple(c.components)
+    if not comps or len(set(comps)) != len(comps) or any(int(k) != k or k < 0 or k > 2 for k in comps):
+        raise InputError(f"{type(c).__name__} on {c.boundary!r}: components {c.components!r} must be distinct "
+                         "indices 0 (x), 1 (y) or 2 (z)")
+
+
+def values(condition: Condition, x: np.ndarray, t: float = 0.0, n: np.ndarray | None = None) -> np.ndarray:
+    """The condition's value at points x and time t, shape ``(m, len(components))``.
+
+    Args:
+        condition: Any condition of this module.
+        x: Points, shape ``(m, gdim)`` [m].
+        t: Time [s].
+        n: Outward unit normals at x, shape ``(m, gdim)`` (tractions and fluxes that use them).
+    """
+    x = np.asarray(x, float)
+    m = len(x)
+    comps = list(condition.components)
+    v = condition.value
+    if not callable(v):
+        out = v
+    elif isinstance(condition, NATURAL):
+        if n is None:
+            raise InputError(f"{type(condition).__name__} on {condition.boundary!r}: value(x, t, n) is evaluated "
+                             "on boundary points with normals; pass n")
+        out = v(x, t, n)
+    else:
+        out = v(x, t)
+    out = np.asarray(out, float)
+    if out.ndim == 0:
+        return np.full((m, len(comps)), float(out))
+    if out.ndim == 1 and out.shape[0] == x.shape[1] and m != x.shape[1] and len(comps) > 1:
+        out = np.broadcast_to(out, (m, x.shape[1]))  # a constant vector
+    if out.ndim == 1:
+        if out.shape[0] != m or len(comps) != 1:
+            if out.shape[0] == len(comps):
+                return np.broadcast_to(out, (m, len(comps))).copy()
+            raise InputError(f"{type(condition).__name__} on {condition.boundary!r}: value has shape "
+                             f"{out.shape} for {m} points and components {tuple(comps)}")
+        return out.reshape(m, 1)
+    if out.shape == (m, len(comps)):
+        return out
+    if out.shape[0] == m and out.shape[1] > max(comps):
+        return out[:, comps]
+    raise InputError(f"{type(condition).__name__} on {condition.boundary!r}: value has shape {out.shape} for "
+                     f"{m} points and components {tuple(comps)}; return (m,), (m, {len(comps)}) or (m, gdim)")
+
+
+def split(conditions: Sequence[Condition]) -> dict[type, list[Condition]]:
+    """The conditions grouped by kind, in their order; unknown objects raise a one-line error."""
+    out: dict[type, list[Condition]] = {k: [] for k in (Displacement, Velocity, Pressure, Traction, Flux)}
+    for c in conditions:
+        if type(c) not in out:
+            raise InputError(f"{c!r} is not a boundary condition; use rkfx.conditions.Displacement, Velocity, "
+                             "Pressure, Traction or Flux")
+        out[type(c)].append(c)
+    return out
