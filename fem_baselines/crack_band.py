@@ -146,6 +146,7 @@ class CrackBandModel(DamageHistory):
         du = ufl.TrialFunction(V)
         self._a = dolfinx.fem.form(ufl.inner(ufl.dot(self._tangent, voigt(du)), voigt(v)) * ufl.dx)
         self._r = dolfinx.fem.form(ufl.inner(self._stress, voigt(v)) * ufl.dx)
+        self._K = dolfinx.fem.create_matrix(self._a)  # one sparsity pattern for every assembly
         self._strain_expr = dolfinx.fem.Expression(voigt(self._u), Q.element.interpolation_points)
         self._strain = dolfinx.fem.Function(Q)
         # Per-element data in DG0 dof order (one dof per cell).
@@ -182,7 +183,9 @@ class CrackBandModel(DamageHistory):
         return dolfinx.fem.assemble_vector(self._r).array[:self.n_dofs].copy()
 
     def tangent(self, x: np.ndarray, t: float) -> sp.csr_matrix:
-        return dolfinx.fem.assemble_matrix(self._a).to_scipy()
+        self._K.set_value(0.0)
+        dolfinx.fem.assemble_matrix(self._K, self._a)
+        return sp.csr_matrix(self._K.to_scipy(), copy=True)
 
     def constraints(self, t: float) -> Constraints:
         return Constraints(self._G, t * self._g_hat, self._g_hat)

@@ -145,3 +145,15 @@ def test_cli_killed_run_resumes_to_the_same_results(tmp_path, monkeypatch):
     assert [r["method"] for r in whole] == [r["method"] for r in resumed]
     for a, b in zip(whole, resumed):
         assert (a["series"], a["errors"], a["info"]) == (b["series"], b["errors"], b["info"]), a["method"]
+
+
+def test_cli_checkpoint_errors_exit_2_with_one_line(capsys, tmp_path):
+    small = ["--method", "rkpm", "--set", "nodes=16", "cells=voronoi", "steps=8"]
+    assert cracked_bar.main([*small, "--checkpoint-every", "5", "--out", str(tmp_path / "a")]) == 0
+    capsys.readouterr()
+    for args, name in ((["--checkpoint-every", "-1"], "checkpoint-every"), (["--resume", str(tmp_path / "none")], "resume"),
+                       ([*small[:-1], "steps=9", "--resume", str(tmp_path / "a")], "other load targets")):
+        with pytest.raises(SystemExit) as e:
+            cracked_bar.main([*args, "--out", str(tmp_path / "b")])
+        err = capsys.readouterr().err
+        assert e.value.code == 2 and name in err and err.count("\n") == 1, err

@@ -99,7 +99,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import damage as dm
-from ..damage_bar import (  # noqa: F401  (strip, gauss_strip, elastic_limit: the case's API)
+from ..damage_bar import (
     CELLS,
     GAUSS_ACROSS,
     GAUSS_ALONG,
@@ -185,7 +185,7 @@ def load_path(s: Strip, model: dm.DamageModel, targets: np.ndarray, snapshots: S
         snapshots: Tip displacements at which stress and damage are recorded.
         energy_step: First dissipation step of the snap-back control [J] (default G_F A / 50).
         rtol: Residual tolerance relative to f_t H (forces per unit thickness).
-        max_iterations: Newton iterations per step before it is cut.
+        max_iterations: Newton iterations (linear solves) per step before it is cut.
         comm: Communicator of the linear solves.
         checkpoint_every, checkpoint_dir, resume: Checkpoints every so many accepted steps
             into ``checkpoint_dir``; continue from the checkpoint folder ``resume``.
@@ -193,7 +193,10 @@ def load_path(s: Strip, model: dm.DamageModel, targets: np.ndarray, snapshots: S
     t0 = time.perf_counter()
     bar = DamageBarModel(s, model)
     curve = LoadCurve(bar, s.thickness, s.H, snapshots)
-    # The dissipation row measures F Delta u with the force F = t sum mu_right, tau per unit thickness.
+    # As the documented paths were computed: tau is G_F A / 50 divided by the thickness t while
+    # the dissipation row measures (F_0 du - u_0 dF) / 2 with the whole force F = t sum mu_right,
+    # so a step dissipates G_F A / (50 t) in all (and the rejection test 0 < D <= 3 tau compares
+    # the dissipation per unit thickness with it).
     tau = model.material.GF * s.H / 50.0 if energy_step is None else energy_step / s.thickness
     stepper = QuasiStatic(NewtonOptions(max_iterations=max_iterations), rtol=rtol, energy_step=tau)
     all_targets = np.unique(np.r_[np.asarray(targets, float), np.asarray(snapshots, float)])

@@ -162,22 +162,29 @@ class Marched:
     wall_time_s: float
 
 
+class _ConstraintRows:
+    """G, G^T and the fixed entries of the step Jacobian: -G^T, G, and the column of -rate
+    (whose values are set per call)."""
+
+    def __init__(self, G: sp.csr_matrix):
+        self.G, self.GT = G, G.T.tocsr()
+        gc = G.tocoo()
+        k, n = G.shape
+        self.rows = [gc.col, n + gc.row, n + np.arange(k)]
+        self.cols = [n + gc.row, gc.col, np.full(k, n + k)]
+        self.data = [-gc.data, gc.data]
+
+
 class _ControlledSystem:
     """F(x, mu, lam) = [r(x, lam) - G^T mu, G x - g(lam), c] of one step (module docstring)."""
 
     linear = False
 
-    def __init__(self, stepper: QuasiStatic, model: Model, G: sp.csr_matrix, weights, tol: float,
+    def __init__(self, stepper: QuasiStatic, model: Model, rows: _ConstraintRows, weights, tol: float,
                  target: float | None = None, tau: float | None = None, lam0: float = 0.0, f0: float = 0.0):
-        self.stepper, self.model, self.G, self.GT = stepper, model, G, G.T.tocsr()
-        self.n, self.k = G.shape[1], G.shape[0]
+        self.stepper, self.model, self.G, self.GT, self.fixed = stepper, model, rows.G, rows.GT, rows
+        self.n, self.k = rows.G.shape[1], rows.G.shape[0]
         self.weights, self.tol, self.target, self.tau, self.lam0, self.f0 = weights, tol, target, tau, lam0, f0
-        gc = G.tocoo()
-        n, k = self.n, self.k
-        # The fixed entries of the Jacobian: -G^T, G, and the column -rate (values set per call).
-        self._rows = [gc.col, n + gc.row, n + np.arange(k)]
-        self._cols = [n + gc.row, gc.col, np.full(k, n + k)]
-        self._data = [-gc.data, gc.data]
 
     def split(self, z):
         return z[:self.n], z[self.n:self.n + self.k], float(z[-1])
@@ -202,8 +209,9 @@ class _ControlledSystem:
         x, _, lam = self.split(z)
         kc = sp.coo_matrix(self.model.tangent(x, lam))
         n, k = self.n, self.k
-        rows, cols = [kc.row, *self._rows], [kc.col, *self._cols]
-        data = [kc.data, *self._data, -np.asarray(self.rate, float)]
+        fx = self.fixed
+        rows, cols = [kc.row, *fx.rows], [kc.col, *fx.cols]
+        data = [kc.data, *fx.data, -np.asarray(self.rate, float)]
         if self.tau is None:  # lam - lam_target
             rows += [[n + k]]
             cols += [[n + k]]
@@ -268,6 +276,7 @@ def march(model: Model, targets, stepper: QuasiStatic = QuasiStatic(), *, record
         raise InputError("quasi-static constraints need rate = dg/dlam (Constraints.rate)")
     G = sp.csr_matrix(con.G)
     n, k = model.layout.size, G.shape[0]
+    constraint_rows = _ConstraintRows(G)
     weights = getattr(model, "reaction_weights", None)
     if weights is not None:
         weights = np.asarray(weights, float)
@@ -317,7 +326,7 @@ def march(model: Model, targets, stepper: QuasiStatic = QuasiStatic(), *, record
         """Newton from the committed state; the converged (x, mu, lam) or the failed result."""
         if set_control is not None:
             set_control(mode)
-        system = _ControlledSystem(stepper, model, G, weights, tol, **control)
+        system = _ControlledSystem(stepper, model, constraint_rows, weights, tol, **control)
         res = newton(system, np.r_[x, mu, lam_start], solves, stepper.newton)
         cur.iterations += res.iterations
         return (system.split(res.z) if res.converged else None), res
