@@ -15,40 +15,44 @@ the element length along the bar, so that an element column failing completely d
 G_F A. ``elements`` is odd, so x = L / 2 is the middle of a column; the two triangles of that
 column get a damage threshold ``weak_factor`` kappa0 and localize the crack.
 
-Solution: displacement control in sub-steps (``rkfx.damage.march``; a crack band of one
-element column never snaps back when w_c > f_t L / E), each solved by Newton's
-method with the consistent tangent (1 - D) C - D' (C eps) (x) d eps_eq / d eps (non-symmetric;
-MUMPS LU through PETSc), following dolfinx's Newton convention for the Dirichlet data
-(lifting with x0 = u, alpha = -1). The strain, stress and tangent live in DG0 spaces; the
-material update is the vectorised numpy code of ``rkfx.damage``. The tip force is the virtual
-work of the stresses on v = (x / L, 0): F = t sum_e sigma_xx,e V_e / L.
+Solution: ``rkfx.solvers.quasi_static.march`` on ``CrackBandModel``, the same stepper as the
+RKPM bar: displacement control in sub-steps with step cutting (a crack band of one element
+column never snaps back when w_c > f_t L / E), each solved by the shared Newton with the
+consistent tangent (1 - D) C - D' (C eps) (x) d eps_eq / d eps (non-symmetric; MUMPS LU through
+``rkfx.linear_solver``). dolfinx assembles the residual and tangent; the Dirichlet conditions are
+unit rows of their dofs imposed with multipliers, whose sum over the right-end u_x dofs (times
+the thickness) is the tip force. The strain, stress and tangent live in DG0 spaces; the
+material update is the vectorised numpy code of ``rkfx.damage``.
 
-Runs on one process (``MPI.COMM_SELF``): the bar has a few hundred unknowns.
+The mesh lives on one process (``MPI.COMM_SELF``): the bar has a few hundred unknowns; the
+linear solves take a communicator.
 """
 from __future__ import annotations
 
-import itertools
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import dolfinx_solver  # noqa: F401  (must precede dolfinx / petsc4py: orders MPI loading)
 
 import numpy as np
+import scipy.sparse as sp
 from mpi4py import MPI
-from petsc4py import PETSc
 
 import dolfinx
 import dolfinx.fem
-import dolfinx.fem.petsc
 import dolfinx.mesh
 import ufl
 
 from rkfx import damage as dm
+from rkfx.damage_bar import DamageHistory, LoadCurve
 from rkfx.errors import InputError
+from rkfx.solvers.fields import single
+from rkfx.solvers.model import Constraints
+from rkfx.solvers.newton import NewtonOptions
+from rkfx.solvers.quasi_static import QuasiStatic, march
 
-__all__ = ["CrackBandResult", "solve_crack_band"]
-
-_prefix_counter = itertools.count()
+__all__ = ["CrackBandModel", "CrackBandResult", "solve_crack_band"]
 
 
 @dataclass
@@ -91,19 +95,106 @@ class CrackBandResult:
     timings: dict[str, float] = field(default_factory=dict)
 
 
-@dataclass(frozen=True)
-class _Trial:
-    u: float
-    force: float
-    x: np.ndarray
-    update: dm.DamageUpdate
-    damage_increment: float
-    iterations: int
+class CrackBandModel(DamageHistory):
+    """The crack-band bar (module docstring) as a quasi-static model of ``rkfx.solvers``; the
+    load factor is the tip displacement u_T.
+
+    Args:
+        L, A: Bar length and cross-section [m], [m^2].
+        E, GF, ft: Young's modulus [Pa], fracture energy [N/m], tensile strength [Pa].
+        elements: Elements along the bar (odd, >= 3).
+        weak_factor: kappa0 multiplier of the middle column (< 1 localizes the crack there).
+
+    Attributes:
+        h, thickness: Element length (band width) and thickness A / h [m].
+        x_cells: Element centroids along the bar, shape ``(num_cells,)`` [m].
+        force_scale: f_t h (residual entries are forces per unit thickness).
+        reaction_weights: The thickness on the right-end u_x rows: F = t sum mu_right.
+
+    Raises:
+        InputError: Bad element count or a band too wide for G_F (w_c / h <= kappa0).
+    """
+
+    linear = False
+
+    def __init__(self, L: float, A: float, E: float, GF: float, ft: float, elements: int,
+                 weak_factor: float = 0.999):
+        if int(elements) != elements or elements < 3 or elements % 2 == 0:
+            raise InputError(f"elements = {elements!r}: use an odd number >= 3 so that x = L/2 is mid-element")
+        n_el = int(elements)
+        h = L / n_el
+        material = dm.DamageMaterial(E, 0.0, ft, GF, "stress")
+        kappa_c = material.critical_opening / h
+        if not kappa_c > material.kappa0:
+            raise InputError(f"crack band h = {h:.3g} is too wide for G_F: w_c / h = {kappa_c:.3g} <= kappa0 = "
+                             f"{material.kappa0:.3g}; use more elements (h < 2 E G_F / f_t^2)")
+        self.elements, self.h, self.thickness = n_el, h, A / h
+        mesh = dolfinx.mesh.create_rectangle(MPI.COMM_SELF, [np.array([0.0, 0.0]), np.array([L, h])], [n_el, 1],
+                                             dolfinx.mesh.CellType.triangle)
+        V = dolfinx.fem.functionspace(mesh, ("Lagrange", 1, (2,)))
+        Q = dolfinx.fem.functionspace(mesh, ("DG", 0, (3,)))
+        T = dolfinx.fem.functionspace(mesh, ("DG", 0, (3, 3)))
+        Q0 = dolfinx.fem.functionspace(mesh, ("DG", 0))
+        self._u = dolfinx.fem.Function(V, name="u")
+        self._stress = dolfinx.fem.Function(Q, name="stress")
+        self._tangent = dolfinx.fem.Function(T, name="tangent")
+
+        def voigt(w):
+            return ufl.as_vector([w[0].dx(0), w[1].dx(1), w[0].dx(1) + w[1].dx(0)])
+
+        v = ufl.TestFunction(V)
+        du = ufl.TrialFunction(V)
+        self._a = dolfinx.fem.form(ufl.inner(ufl.dot(self._tangent, voigt(du)), voigt(v)) * ufl.dx)
+        self._r = dolfinx.fem.form(ufl.inner(self._stress, voigt(v)) * ufl.dx)
+        self._K = dolfinx.fem.create_matrix(self._a)  # one sparsity pattern for every assembly
+        self._strain_expr = dolfinx.fem.Expression(voigt(self._u), Q.element.interpolation_points)
+        self._strain = dolfinx.fem.Function(Q)
+        # Per-element data in DG0 dof order (one dof per cell).
+        volume = dolfinx.fem.assemble_vector(dolfinx.fem.form(ufl.TestFunction(Q0) * ufl.dx)).array.copy()
+        xc = dolfinx.fem.Function(Q0)
+        xc.interpolate(dolfinx.fem.Expression(ufl.SpatialCoordinate(mesh)[0], Q0.element.interpolation_points))
+        self.x_cells = xc.x.array.copy()
+        weak = np.abs(self.x_cells - 0.5 * L) < 0.5 * h
+        self._start_history(dm.damage_model(material, volume, np.where(weak, weak_factor, 1.0), kappa_c=kappa_c,
+                                            regularized=False))
+
+        fdim = mesh.topology.dim - 1
+        left = dolfinx.mesh.locate_entities_boundary(mesh, fdim, lambda x: np.isclose(x[0], 0.0))
+        right = dolfinx.mesh.locate_entities_boundary(mesh, fdim, lambda x: np.isclose(x[0], L))
+        # Unit rows of the Dirichlet dofs: u_x = u_T on the right end, u = 0 on the left one, u_y = 0 on the right.
+        dofs, g_hat = [], []
+        for facets, comp, value in ((right, 0, 1.0), (left, 0, 0.0), (left, 1, 0.0), (right, 1, 0.0)):
+            d = np.sort(dolfinx.fem.locate_dofs_topological(V.sub(comp), fdim, facets))
+            dofs.append(d)
+            g_hat.append(np.full(len(d), value))
+        dofs, self._g_hat = np.concatenate(dofs), np.concatenate(g_hat)
+        self.n_dofs = V.dofmap.index_map.size_local * V.dofmap.index_map_bs
+        self.layout = single("u", 2, 0, self.n_dofs // 2)
+        self._G = sp.csr_matrix((np.ones(len(dofs)), (np.arange(len(dofs)), dofs)), shape=(len(dofs), self.n_dofs))
+        self.force_scale = ft * h
+        self.reaction_weights = self.thickness * self._g_hat
+
+    def residual(self, x: np.ndarray, t: float) -> np.ndarray:
+        self._u.x.array[:] = x
+        self._strain.interpolate(self._strain_expr)
+        upd = self.update(self._strain.x.array.reshape(-1, 3).copy())
+        self._stress.x.array[:] = upd.stress.ravel()
+        self._tangent.x.array[:] = upd.tangent.ravel()
+        return dolfinx.fem.assemble_vector(self._r).array[:self.n_dofs].copy()
+
+    def tangent(self, x: np.ndarray, t: float) -> sp.csr_matrix:
+        self._K.set_value(0.0)
+        dolfinx.fem.assemble_matrix(self._K, self._a)
+        return sp.csr_matrix(self._K.to_scipy(), copy=True)
+
+    def constraints(self, t: float) -> Constraints:
+        return Constraints(self._G, t * self._g_hat, self._g_hat)
 
 
 def solve_crack_band(L: float, A: float, E: float, GF: float, ft: float, elements: int,
                      targets: np.ndarray, weak_factor: float = 0.999, u_profile: float | None = None,
-                     rtol: float = 1e-10, max_iterations: int = 25) -> CrackBandResult:
+                     rtol: float = 1e-10, max_iterations: int = 24, comm=MPI.COMM_SELF, checkpoint_every: int = 0,
+                     checkpoint_dir: Path | None = None, resume: Path | None = None) -> CrackBandResult:
     """Crack-band FEM load path of the bar through the tip displacements ``targets``.
 
     Args:
@@ -114,140 +205,30 @@ def solve_crack_band(L: float, A: float, E: float, GF: float, ft: float, element
         targets: Increasing tip displacements every one of which is reached, shape ``(k,)`` [m].
         weak_factor: kappa0 multiplier of the middle column (< 1 localizes the crack there).
         u_profile: Tip displacement at which the damage profile is recorded (default: the last).
-        rtol: Newton tolerance on the residual, relative to f_t A.
+        rtol: Newton tolerance on the residual, relative to f_t h.
         max_iterations: Newton iterations per sub-step before the step is cut.
+        comm: Communicator of the linear solves.
+        checkpoint_every, checkpoint_dir, resume: Checkpoints every so many accepted steps
+            into ``checkpoint_dir``; continue from the checkpoint folder ``resume``.
 
     Raises:
         InputError: Bad element count or a band too wide for G_F (w_c / h <= kappa0).
     """
-    if int(elements) != elements or elements < 3 or elements % 2 == 0:
-        raise InputError(f"elements = {elements!r}: use an odd number >= 3 so that x = L/2 is mid-element")
     t_start = time.perf_counter()
-    comm = MPI.COMM_SELF
-    n_el = int(elements)
-    h = L / n_el
-    thickness = A / h
-    material = dm.DamageMaterial(E, 0.0, ft, GF, "stress")
-    kappa_c = material.critical_opening / h
-    if not kappa_c > material.kappa0:
-        raise InputError(f"crack band h = {h:.3g} is too wide for G_F: w_c / h = {kappa_c:.3g} <= kappa0 = "
-                         f"{material.kappa0:.3g}; use more elements (h < 2 E G_F / f_t^2)")
-    mesh = dolfinx.mesh.create_rectangle(comm, [np.array([0.0, 0.0]), np.array([L, h])], [n_el, 1],
-                                         dolfinx.mesh.CellType.triangle)
-    V = dolfinx.fem.functionspace(mesh, ("Lagrange", 1, (2,)))
-    Q = dolfinx.fem.functionspace(mesh, ("DG", 0, (3,)))
-    T = dolfinx.fem.functionspace(mesh, ("DG", 0, (3, 3)))
-    Q0 = dolfinx.fem.functionspace(mesh, ("DG", 0))
-    u = dolfinx.fem.Function(V, name="u")
-    stress = dolfinx.fem.Function(Q, name="stress")
-    tangent = dolfinx.fem.Function(T, name="tangent")
-
-    def voigt(w):
-        return ufl.as_vector([w[0].dx(0), w[1].dx(1), w[0].dx(1) + w[1].dx(0)])
-
-    v = ufl.TestFunction(V)
-    du = ufl.TrialFunction(V)
-    a_form = dolfinx.fem.form(ufl.inner(ufl.dot(tangent, voigt(du)), voigt(v)) * ufl.dx)
-    r_form = dolfinx.fem.form(ufl.inner(stress, voigt(v)) * ufl.dx)
-    strain_expr = dolfinx.fem.Expression(voigt(u), Q.element.interpolation_points)
-    strain = dolfinx.fem.Function(Q)
-    # Per-element data in DG0 dof order (one dof per cell).
-    volume = dolfinx.fem.assemble_vector(dolfinx.fem.form(ufl.TestFunction(Q0) * ufl.dx)).array.copy()
-    xc = dolfinx.fem.Function(Q0)
-    xc.interpolate(dolfinx.fem.Expression(ufl.SpatialCoordinate(mesh)[0], Q0.element.interpolation_points))
-    x_cells = xc.x.array.copy()
-    weak = np.abs(x_cells - 0.5 * L) < 0.5 * h
-    model = dm.damage_model(material, volume, np.where(weak, weak_factor, 1.0), kappa_c=kappa_c, regularized=False)
-
-    fdim = mesh.topology.dim - 1
-    left = dolfinx.mesh.locate_entities_boundary(mesh, fdim, lambda x: np.isclose(x[0], 0.0))
-    right = dolfinx.mesh.locate_entities_boundary(mesh, fdim, lambda x: np.isclose(x[0], L))
-    tip = dolfinx.fem.Constant(mesh, PETSc.ScalarType(0.0))
-    bcs = []
-    for facets, comp, value in ((left, 0, PETSc.ScalarType(0.0)), (right, 0, tip), (left, 1, PETSc.ScalarType(0.0)),
-                                (right, 1, PETSc.ScalarType(0.0))):
-        dofs = dolfinx.fem.locate_dofs_topological(V.sub(comp), fdim, facets)
-        bcs.append(dolfinx.fem.dirichletbc(value, dofs, V.sub(comp)))
-    n_dofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
-
-    ksp = PETSc.KSP().create(comm)
-    ksp.setOptionsPrefix(f"rkfx_crack_band_{next(_prefix_counter)}_")
-    ksp.setType("preonly")
-    ksp.getPC().setType("lu")
-    ksp.getPC().setFactorSolverType("mumps")
-    b = dolfinx.fem.petsc.create_vector(V)
-    dx = dolfinx.fem.petsc.create_vector(V)
-    t_setup = time.perf_counter()
-
-    scale = ft * h  # residual entries are forces per unit thickness
-    state = dm.initial_state(model)
-    history = {"u": [0.0], "force": [0.0], "cod": [0.0], "dissipated": [0.0], "elastic": [0.0]}
-    profile = {"u": None, "D": np.zeros(len(volume))}
+    model = CrackBandModel(L, A, E, GF, ft, elements, weak_factor)
     u_profile = float(targets[-1] if u_profile is None else u_profile)
-    counters = {"iterations": 0}
-    accepted = {"u": np.zeros_like(u.x.array)}
-
-    def material_at(x_array):
-        u.x.array[:] = x_array
-        strain.interpolate(strain_expr)
-        return dm.update(model, state, strain.x.array.reshape(-1, 3), tangent=True, tangent_floor=1e-8,
-                         loading_tolerance=1e-9)
-
-    def attempt(u_target):
-        tip.value = u_target
-        x = accepted["u"].copy()
-        for it in range(max_iterations):
-            upd = material_at(x)
-            stress.x.array[:] = upd.stress.ravel()
-            tangent.x.array[:] = upd.tangent.ravel()
-            with b.localForm() as b_local:
-                b_local.set(0.0)
-            dolfinx.fem.petsc.assemble_vector(b, r_form)
-            dolfinx.fem.petsc.apply_lifting(b, [a_form], bcs=[bcs], x0=[u.x.petsc_vec], alpha=-1.0)
-            b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-            dolfinx.fem.petsc.set_bc(b, bcs, u.x.petsc_vec, -1.0)
-            if it > 0 and b.norm(PETSc.NormType.NORM_INFINITY) <= rtol * scale:
-                counters["iterations"] += it
-                force = thickness * float(np.sum(upd.stress[:, 0] * volume)) / L
-                return _Trial(u_target, force, x, upd, float(np.max(upd.state.damage - state.damage)), it)
-            mat = dolfinx.fem.petsc.assemble_matrix(a_form, bcs=bcs)
-            mat.assemble()
-            ksp.setOperators(mat)
-            ksp.solve(b, dx)
-            mat.destroy()
-            step = dx.array_r.copy()
-            if not np.all(np.isfinite(step)):
-                return None
-            x = x - step
-            u.x.array[:] = x
-        return None
-
-    def accept(trial):
-        nonlocal state
-        accepted["u"] = trial.x.copy()
-        state = trial.update.state
-        eps = strain.x.array.reshape(-1, 3)
-        u_t = trial.u
-        history["u"].append(u_t)
-        history["force"].append(trial.force)
-        history["cod"].append(float(np.sum(state.damage * eps[:, 0] * volume)) / h)
-        history["dissipated"].append(thickness * float(state.dissipated.sum()))
-        history["elastic"].append(0.5 * thickness * float(np.sum(trial.update.stress * eps * volume[:, None])))
-        if profile["u"] is None and u_t >= u_profile * (1 - 1e-12):
-            profile["u"], profile["D"] = u_t, state.damage.copy()
-
-    targets = np.unique(np.r_[np.asarray(targets, float), u_profile])
-    cuts = dm.march(targets, attempt, accept)["cuts"]
-    ksp.destroy()
-    b.destroy()
-    dx.destroy()
-    wall = time.perf_counter() - t_start
-    u_hist, force = np.array(history["u"]), np.array(history["force"])
+    curve = LoadCurve(model, model.thickness, model.h, [u_profile])
+    t_setup = time.perf_counter()
+    out = march(model, np.unique(np.r_[np.asarray(targets, float), u_profile]),
+                QuasiStatic(NewtonOptions(max_iterations=max_iterations), rtol=rtol), recorder=curve, comm=comm,
+                checkpoint_every=checkpoint_every, checkpoint_dir=checkpoint_dir, resume=resume)
+    c = curve.series()
+    profile = curve.snapshots.get(u_profile)
     return CrackBandResult(
-        elements=n_el, h=h, u=u_hist, force=force, cod=np.array(history["cod"]),
-        dissipated=np.array(history["dissipated"]), elastic=np.array(history["elastic"]), x=x_cells,
-        damage_profile=profile["D"],
-        u_profile=profile["u"] if profile["u"] is not None else float(u_hist[-1]),
-        u_T_max=dm.failure_displacement(u_hist, force), n_dofs=int(n_dofs), wall_time_s=wall,
-        iterations=counters["iterations"], cuts=cuts,
-        timings={"setup": t_setup - t_start, "path": time.perf_counter() - t_setup})
+        elements=model.elements, h=model.h, u=c["u"], force=c["force"], cod=c["cod"], dissipated=c["dissipated"],
+        elastic=c["elastic"], x=model.x_cells,
+        damage_profile=profile[1] if profile else np.zeros(model.points.num_points),
+        u_profile=profile[2] if profile else float(c["u"][-1]),
+        u_T_max=dm.failure_displacement(c["u"], c["force"]), n_dofs=model.n_dofs,
+        wall_time_s=t_setup - t_start + out.wall_time_s, iterations=out.iterations, cuts=out.cuts,
+        timings={"setup": t_setup - t_start, "path": out.wall_time_s})

@@ -18,8 +18,8 @@ a compiled loop would not pay).
 * The smeared stress (4.20)/(4.30), sigma = (1 - D) C eps, its consistent tangent, and the
   dissipated energy.
 * What the damage solvers share (``rkfx.cases.cracked_bar``, ``fem_baselines.crack_band``):
-  ``march``, displacement-controlled stepping with step cutting and a dissipation-controlled
-  fallback through snap-backs, and ``failure_displacement``, u_T^max read off a load path.
+  ``failure_displacement``, u_T^max read off a load path (their stepping, with step cutting
+  and dissipation control through snap-backs, is ``rkfx.solvers.quasi_static.march``).
 
 Dissipation bookkeeping. Damage dissipates Y dD per unit volume with the energy release rate
 Y = eps : C : eps / 2. In uniaxial tension, the state the energy scaling (4.27) is built on,
@@ -544,89 +544,10 @@ def check_regularization(model: DamageModel, state: DamageState) -> None:
             f"until V_L / A_L < E G_F / f_t^2 = {mat.E * mat.GF / mat.ft**2:.3g} or raise GF")
 
 
-# --------------------------------------------------------------------------- load stepping
+# --------------------------------------------------------------------------- load paths
 # Shared by the damage solvers (rkfx.cases.cracked_bar, fem_baselines.crack_band): both drive
-# a tip displacement through softening and read the same quantities off the curve.
-
-
-def march(targets: np.ndarray, attempt, accept, arc=None, energy_step: float = 0.0,
-          max_damage_increment: float = 0.1, min_fraction: float = 1e-3, max_arc_steps: int = 10000) -> dict:
-    """Displacement-controlled stepping through ``targets``, with dissipation control through
-    snap-backs.
-
-    Each target is reached in sub-steps, each tried with ``attempt(u)`` (Newton at the tip
-    displacement u); a sub-step is cut by 4 when that fails or raises the damage of some point
-    by more than ``max_damage_increment``, and grows back by 2 after each success. A sub-step
-    smaller than ``min_fraction`` of the target spacing that still fails means that no
-    equilibrium path is continuous in u (a snap-back: the force must drop while u decreases).
-    The path is then followed by ``arc(tau)``, steps of prescribed dissipated energy tau
-    (Gutierrez 2004; Verhoosel et al. 2009), until u is past the stalled displacement again or
-    the force has vanished (the bar has broken), and displacement control resumes.
-
-    Args:
-        targets: Increasing tip displacements, shape ``(k,)`` [m]; every one is reached exactly.
-        attempt: ``attempt(u) -> trial | None``.
-        accept: ``accept(trial)`` commits a trial (and records the step).
-        arc: ``arc(tau) -> trial | None``, a step that dissipates the energy tau; or ``None``.
-        energy_step: First energy step tau of ``arc`` [J].
-        max_damage_increment: Largest damage growth of a point per displacement sub-step.
-        min_fraction: Smallest sub-step, as a fraction of the target spacing.
-        max_arc_steps: Bound on the dissipation-controlled steps.
-
-    Trials have attributes ``u`` (tip displacement), ``force`` and ``damage_increment`` (max
-    over points vs the last accepted state); ``arc`` steps are cut by 4 like displacement steps
-    when they fail or exceed ``max_damage_increment``.
-
-    Returns:
-        Counters ``{"cuts", "arc_steps"}``.
-
-    Raises:
-        SolverError: The smallest sub-step fails and no (working) ``arc`` is given.
-    """
-    from .errors import SolverError
-
-    count = {"cuts": 0, "arc_steps": 0}
-    u, f_max = 0.0, 0.0
-    spacing = np.diff(np.r_[0.0, targets])
-    du = spacing[0]
-    tau = energy_step
-    for target, span in zip(targets, spacing):
-        smallest = min_fraction * span
-        du = min(max(du, smallest), target - u)
-        while u < target:
-            un = target if u + du >= target * (1 - 1e-12) else u + du
-            trial = attempt(un)
-            small = un - u <= smallest * (1 + 1e-9)
-            if trial is not None and (trial.damage_increment <= max_damage_increment or small):
-                accept(trial)
-                f_max = max(f_max, trial.force)
-                u, du = un, 2.0 * (un - u)
-                continue
-            if not small:
-                du = max((un - u) / 4.0, smallest)
-                count["cuts"] += 1
-                continue
-            if arc is None or not tau > 0:
-                raise SolverError(f"no equilibrium found at tip displacement {un:.6g} even with a sub-step of "
-                                  f"{un - u:.3g} (a snap-back); use more steps or check the damage parameters")
-            stall = un
-            while True:
-                trial = arc(tau)
-                if trial is None or trial.damage_increment > max_damage_increment:
-                    tau /= 4.0
-                    if tau < 1e-6 * energy_step:
-                        raise SolverError(f"the dissipation-controlled path stalls at tip displacement {u:.6g}; "
-                                          "use more steps or check the damage parameters")
-                    continue
-                accept(trial)
-                count["arc_steps"] += 1
-                u = trial.u
-                if trial.u >= stall or trial.force <= 1e-6 * f_max or count["arc_steps"] >= max_arc_steps:
-                    break
-                tau = min(2.0 * tau, energy_step)
-            du = smallest
-        du = min(du, span)
-    return count
+# a tip displacement through softening (rkfx.solvers.quasi_static.march) and read the same
+# quantities off the curve.
 
 
 def failure_displacement(u: np.ndarray, force: np.ndarray, rtol: float = 1e-6) -> float:

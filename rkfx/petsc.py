@@ -24,21 +24,29 @@ class SolverDiverged(SolverError):
 
 def to_petsc_mat(a: sp.spmatrix, comm=MPI.COMM_WORLD) -> PETSc.Mat:
     """Distributed AIJ matrix from a global scipy sparse matrix held on every rank."""
-    a = sp.csr_matrix(a)
-    a.sort_indices()
+    a = _sorted_csr(a)
     n_rows, n_cols = a.shape
     mat = PETSc.Mat().create(comm=comm)
     mat.setSizes(((PETSc.DECIDE, n_rows), (PETSc.DECIDE, n_cols)))
     mat.setType(PETSc.Mat.Type.AIJ)
     mat.setUp()
-    lo, hi = mat.getOwnershipRange()
-    ptr = a.indptr[lo:hi + 1]
-    local_ptr = (ptr - ptr[0]).astype(PETSc.IntType)
-    cols = a.indices[ptr[0]:ptr[-1]].astype(PETSc.IntType)
-    vals = a.data[ptr[0]:ptr[-1]].astype(PETSc.ScalarType)
-    mat.setPreallocationCSR((local_ptr, cols, vals))
+    mat.setPreallocationCSR(_owned_rows(a, mat))
     mat.assemble()
     return mat
+
+
+def _sorted_csr(a: sp.spmatrix) -> sp.csr_matrix:
+    a = sp.csr_matrix(a)
+    a.sort_indices()
+    return a
+
+
+def _owned_rows(a: sp.csr_matrix, mat: PETSc.Mat):
+    """The CSR arrays (local row pointer, global columns, values) of the rows this rank owns."""
+    lo, hi = mat.getOwnershipRange()
+    ptr = a.indptr[lo:hi + 1]
+    return ((ptr - ptr[0]).astype(PETSc.IntType), a.indices[ptr[0]:ptr[-1]].astype(PETSc.IntType),
+            a.data[ptr[0]:ptr[-1]].astype(PETSc.ScalarType))
 
 
 def to_petsc_vec(v: np.ndarray, mat: PETSc.Mat) -> PETSc.Vec:
@@ -99,6 +107,8 @@ class LinearSolver:
 
     def __init__(self, a: sp.spmatrix, comm=MPI.COMM_WORLD, solver: str = "mumps"):
         self.solver = solver
+        a = _sorted_csr(a)
+        self.pattern = (a.shape, a.indptr.copy(), a.indices.copy())
         self.mat = to_petsc_mat(a, comm)
         self.ksp = make_ksp(self.mat, solver)
         self.rhs = self.mat.createVecLeft()
@@ -140,6 +150,20 @@ class LinearSolver:
                           "satisfies the equations but is not unique in those modes", RuntimeWarning, stacklevel=2)
             self._warned = True
         return gather(self.x)
+
+    def matches(self, a: sp.spmatrix) -> bool:
+        """Whether ``a`` has this system's sparsity pattern (so ``refactor`` may take it)."""
+        a = _sorted_csr(a)
+        shape, indptr, indices = self.pattern
+        return a.shape == shape and np.array_equal(a.indptr, indptr) and np.array_equal(a.indices, indices)
+
+    def refactor(self, a: sp.spmatrix) -> None:
+        """Take the values of ``a`` (same pattern): the next solve factorizes anew, reusing the
+        symbolic analysis and the PETSc objects."""
+        self.mat.zeroEntries()
+        self.mat.setValuesCSR(*_owned_rows(_sorted_csr(a), self.mat))
+        self.mat.assemble()
+        self.ksp.setOperators(self.mat)
 
     def destroy(self) -> None:
         for obj in (self.ksp, self.mat, self.rhs, self.x, self.residual):

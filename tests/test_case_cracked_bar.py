@@ -118,3 +118,42 @@ def test_bad_parameters_exit_2_with_one_line(capsys, setting, name):
         cracked_bar.main(["--set", setting])
     err = capsys.readouterr().err
     assert e.value.code == 2 and name in err and err.count("\n") == 1
+
+
+def test_cli_killed_run_resumes_to_the_same_results(tmp_path, monkeypatch):
+    """--checkpoint-every / --resume: a run killed inside a later load path, resumed into
+    another folder, reports what an uninterrupted run reports (wall times aside)."""
+    from rkfx.damage_bar import LoadCurve
+
+    args = ["--method", "rkpm", "--set", "nodes=16", "cells=voronoi", "steps=30", "--checkpoint-every", "25"]
+    assert cracked_bar.main([*args, "--out", str(tmp_path / "whole")]) == 0
+    record, seen = LoadCurve.record, []
+
+    def killed(self, state):
+        record(self, state)
+        seen.append(state.step)
+        if len(seen) == 90:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(LoadCurve, "record", killed)
+    with pytest.raises(KeyboardInterrupt):
+        cracked_bar.main([*args, "--out", str(tmp_path / "killed")])
+    monkeypatch.setattr(LoadCurve, "record", record)
+    assert 0 < seen[-1] < len(seen)  # killed inside a later path
+    assert cracked_bar.main([*args, "--out", str(tmp_path / "resumed"), "--resume", str(tmp_path / "killed")]) == 0
+    whole, resumed = (json.loads((tmp_path / d / "results.json").read_text())["runs"] for d in ("whole", "resumed"))
+    assert [r["method"] for r in whole] == [r["method"] for r in resumed]
+    for a, b in zip(whole, resumed):
+        assert (a["series"], a["errors"], a["info"]) == (b["series"], b["errors"], b["info"]), a["method"]
+
+
+def test_cli_checkpoint_errors_exit_2_with_one_line(capsys, tmp_path):
+    small = ["--method", "rkpm", "--set", "nodes=16", "cells=voronoi", "steps=8"]
+    assert cracked_bar.main([*small, "--checkpoint-every", "5", "--out", str(tmp_path / "a")]) == 0
+    capsys.readouterr()
+    for args, name in ((["--checkpoint-every", "-1"], "checkpoint-every"), (["--resume", str(tmp_path / "none")], "resume"),
+                       ([*small[:-1], "steps=9", "--resume", str(tmp_path / "a")], "other load targets")):
+        with pytest.raises(SystemExit) as e:
+            cracked_bar.main([*args, "--out", str(tmp_path / "b")])
+        err = capsys.readouterr().err
+        assert e.value.code == 2 and name in err and err.count("\n") == 1, err

@@ -43,12 +43,14 @@ only triggers the crack). Unregularized model: one constant kappa_c for every n,
 the regularized value of the 16-node model's weak particles, so that the 16-node models agree
 and the refined ones dissipate less (the band narrows while g_L = f_t kappa_c / 2 stays).
 
-Solution. Displacement control in sub-steps (``rkfx.damage.march``): an elastic step to 98% of
+Solution. The discretization and its model (``rkfx.damage_bar``: ``strip``, ``DamageBarModel``)
+are driven by the quasi-static stepper of the core (``rkfx.solvers.quasi_static.march``), as
+is the crack-band FEM. Displacement control in sub-steps: an elastic step to 98% of
 the first damage threshold, a step just past it (by a tenth of the weakening, so that only the
 weak particles start to damage and the path takes the localized branch, not the homogeneous
 one), then ``steps`` equal targets to ``u_end`` x w_c. Each sub-step is
 solved by Newton's method on the constrained system [[K_t, -G^T], [G, 0]] with the consistent
-tangent (non-symmetric; sparse LU); sub-steps are cut when Newton fails or a particle's damage
+tangent (non-symmetric; MUMPS LU); sub-steps are cut when Newton fails or a particle's damage
 grows by more than 0.1. Where no path is continuous in u_T the path is followed by steps of
 prescribed dissipated energy, (F_0 du - u_0 dF) / 2 = tau, with u_T as a further unknown, until
 u_T is past the stall or the bar has broken, and displacement control resumes. This happens in
@@ -80,9 +82,13 @@ triangles (``fem_baselines.crack_band``) with n - 1 elements along the bar.
 Parameters (``--set NAME=VALUE``; any consistent units, the seed's are dimensionless): E and
 ft [stress], GF [force / length], L [length], A [length^2], nodes (list), weak_factor [-],
 steps, u_end [-, times w_c], stress_at [-], support_factor [-], cells (list: voronoi,
-median-dual).
+median-dual). ``--checkpoint-every N`` writes each load path's state every N accepted steps
+(and at its end) to OUT/checkpoints/, and ``--resume DIR`` continues an interrupted invocation:
+finished paths are read back from their last checkpoint, the interrupted one continues from its
+own, with the same results as an uninterrupted run.
 
     python -m rkfx.cases.cracked_bar [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
+                                     [--checkpoint-every N] [--resume DIR]
 """
 import sys
 import time
@@ -91,26 +97,27 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from .. import damage as dm
-from ..boundary import Dirichlet, transformation_constraints
+from ..damage_bar import (
+    CELLS,
+    GAUSS_ACROSS,
+    GAUSS_ALONG,
+    DamageBarModel,
+    LoadCurve,
+    Strip,
+    elastic_limit,
+    gauss_strip,
+    strip,
+)
 from ..errors import InputError, SolverError
-from ..grid_cells import grid_domains
-from ..nodal_domains import nodal_domains
-from ..operators import block_diagonal, strain_matrix
-from ..particles import Particles, structured
-from ..quadrature import smoothed_gradients
-from ..shape_functions import RKApproximation, evaluate, rk_approximation
-from ..sparse_rows import SparseRows
+from ..solvers.checkpoint import CHECKPOINT
+from ..solvers.newton import NewtonOptions
+from ..solvers.quasi_static import QuasiStatic, march
 from . import _cli
 from ._cli import Param, Results, Run
 
 NAME = "cracked_bar"
-CELLS = ("voronoi", "median-dual")
-GAUSS_ALONG, GAUSS_ACROSS = 8, 2
-TANGENT_FLOOR = 1e-8  # lower bound of 1 - D in the Newton matrix only (failed particles)
 MEDIAN_DUAL_END = 1.6  # median-dual models are followed to 1.6 w_c: they break near 1.47 w_c
 
 PARAMS = {
@@ -130,104 +137,7 @@ PARAMS = {
 QUICK = {"nodes": [16, 32], "cells": ["voronoi"], "steps": 60}
 
 
-# --------------------------------------------------------------------------- discretization
-
-
-@dataclass(frozen=True)
-class Strip:
-    """The 2-D bar: particles, RK approximation, an integration rule and the constraints.
-
-    Attributes:
-        p: Particles (two rows of nodes).
-        rk: RK approximation.
-        b: Strain rows (eps_xx, eps_yy, gamma_xy) per integration point, shape ``(3 m, 2 n)``.
-        points: Integration points (the nodes for SCNI), shape ``(m, 2)``.
-        volume: Weights V_L, shape ``(m,)`` [area per unit thickness].
-        extent: x-range of each point's cell, shape ``(m, 2)``.
-        geometry: Cell geometry of the SCNI cells (for A_L), or ``None`` for Gauss points.
-        g: Constraint rows, shape ``(k, 2 n)``; g_unit: their values at u_T = 1, shape ``(k,)``.
-        right: Constraint rows of u_x on the right end (their multipliers sum to the force).
-        H: Height [length]; thickness: A / H.
-    """
-
-    p: Particles
-    rk: RKApproximation
-    b: sp.csr_matrix
-    points: np.ndarray
-    volume: np.ndarray
-    extent: np.ndarray
-    geometry: dm.CellGeometry | None
-    g: sp.csr_matrix
-    g_unit: np.ndarray
-    right: np.ndarray
-    H: float
-    thickness: float
-
-
-def strip(L: float, A: float, n: int, cells: str = "voronoi", support_factor: float = 1.5) -> Strip:
-    """The SCNI discretization of the bar with ``n`` nodes along the axis."""
-    h = L / (n - 1)
-    p = structured(L, h, n, 2)
-    rk = rk_approximation(p.x, p.spacing, support_factor)
-    if cells == "voronoi":
-        domains = grid_domains(np.linspace(0.0, L, n), np.array([0.0, h]))  # the node order of structured
-        geometry = dm.cell_geometry(domains)
-    elif cells == "median-dual":
-        domains = nodal_domains(p)
-        geometry = dm.cell_geometry(p)
-    else:
-        raise InputError(f"unknown cells {cells!r}; choose from {', '.join(CELLS)}")
-    grad = smoothed_gradients(p, rk, domains, subcells=False).cell
-    lo, hi = np.full(p.num_nodes, np.inf), np.full(p.num_nodes, -np.inf)
-    np.minimum.at(lo, geometry.node, geometry.vertices[:, :, 0].min(axis=1))
-    np.maximum.at(hi, geometry.node, geometry.vertices[:, :, 0].max(axis=1))
-    return _with_constraints(p, rk, strain_matrix(grad).tocsr(), p.x, domains.area, np.c_[lo, hi], geometry, h, A)
-
-
-def gauss_strip(L: float, A: float, n: int, support_factor: float = 1.5) -> Strip:
-    """The same bar integrated by Gauss points on the background cells [x_i, x_i+1] x [0, H]
-    (8 along the axis x 2 across), with direct gradients of the RK shape functions."""
-    h = L / (n - 1)
-    p = structured(L, h, n, 2)
-    rk = rk_approximation(p.x, p.spacing, support_factor)
-    s1, w1 = np.polynomial.legendre.leggauss(GAUSS_ALONG)
-    s2, w2 = np.polynomial.legendre.leggauss(GAUSS_ACROSS)
-    x0 = np.linspace(0.0, L, n)[:-1]
-    px = (x0[:, None, None] + 0.5 * h * (1 + s1)[None, :, None]) + 0 * s2[None, None, :]
-    py = np.broadcast_to(0.5 * h * (1 + s2)[None, None, :], px.shape)
-    pts = np.column_stack([px.ravel(), py.ravel()])
-    weights = np.broadcast_to(0.25 * h * h * w1[None, :, None] * w2[None, None, :], px.shape).ravel()
-    rows = evaluate(rk, pts, gradients=True)
-    grad = SparseRows(rows.indptr, rows.indices, rows.data[:, 1:], rows.num_cols)
-    cell = np.repeat(x0, GAUSS_ALONG * GAUSS_ACROSS)
-    return _with_constraints(p, rk, strain_matrix(grad).tocsr(), pts, np.ascontiguousarray(weights),
-                             np.c_[cell, cell + h], None, h, A)
-
-
-def _with_constraints(p, rk, b, points, volume, extent, geometry, h, A) -> Strip:
-    def const(value):
-        return lambda x: np.full(len(x), value)
-
-    bcs = [Dirichlet("right", const(1.0), (0,)), Dirichlet("left", const(0.0), (0,)),
-           Dirichlet("left", const(0.0), (1,)), Dirichlet("right", const(0.0), (1,))]
-    g, g_unit = transformation_constraints(p, rk, bcs)
-    right = np.arange(len(p.boundary_nodes("right")))  # the first Dirichlet's rows
-    return Strip(p, rk, b, points, volume, extent, geometry, g, g_unit, right, h, A / h)
-
-
 # --------------------------------------------------------------------------- load path
-
-
-@dataclass(frozen=True)
-class _Trial:
-    u: float
-    force: float
-    d: np.ndarray
-    mu: np.ndarray
-    update: dm.DamageUpdate
-    strain: np.ndarray
-    damage_increment: float
-    iterations: int
 
 
 @dataclass
@@ -259,68 +169,14 @@ class LoadPath:
     wall_time_s: float
 
 
-def elastic_limit(s: Strip, model: dm.DamageModel) -> float:
-    """Tip displacement at which the first point reaches its damage threshold (elastic solve)."""
-    state = dm.initial_state(model)
-    upd = dm.update(model, state, np.zeros((len(model.volume), 3)))
-    k = s.b.T @ block_diagonal(model.volume[:, None, None] * upd.tangent) @ s.b
-    nd = s.b.shape[1]
-    x = spla.spsolve(sp.bmat([[k, -s.g.T], [s.g, None]], format="csc"), np.r_[np.zeros(nd), s.g_unit])
-    eq = dm.equivalent_strain((s.b @ x[:nd]).reshape(-1, 3), model.material.nu, model.material.plane)
-    return float(np.min(model.kappa0[eq > 0] / eq[eq > 0]))
-
-
-class _NewtonMatrix:
-    """The bordered Newton matrix [[K_t, -G^T, 0], [G, 0, -g], [0, c^T, c_u]] in a fixed pattern.
-
-    K_t = B^T blockdiag(V_q T_q) B is formed from dense blocks per point (a point's three strain
-    rows touch few columns): each Newton iteration then costs one batched matmul, one bincount
-    and one sparse LU rather than a chain of sparse products. Displacement control uses the
-    border row c = 0, c_u = 1 (Delta u = 0); dissipation control c = -u_0 t e_right / 2,
-    c_u = F_0 / 2.
-    """
-
-    def __init__(self, b: sp.csr_matrix, g: sp.csr_matrix, g_unit: np.ndarray, right: np.ndarray):
-        b = b.tocsr()
-        nd, k = b.shape[1], g.shape[0]
-        m = b.shape[0] // 3
-        n = nd + k + 1
-        cols = [np.unique(b.indices[b.indptr[3 * q]:b.indptr[3 * q + 3]]) for q in range(m)]
-        width = max(len(c) for c in cols)
-        self.cols = np.zeros((m, width), np.int64)
-        self.local = np.zeros((m, 3, width))
-        for q, c in enumerate(cols):
-            self.cols[q, :len(c)] = c
-            for a in range(3):
-                lo, hi = b.indptr[3 * q + a], b.indptr[3 * q + a + 1]
-                np.add.at(self.local[q, a], np.searchsorted(c, b.indices[lo:hi]), b.data[lo:hi])
-        gc = g.tocoo()
-        rows = [np.repeat(self.cols, width, axis=1).ravel(), gc.col, nd + gc.row, nd + np.arange(k),
-                np.full(len(right), n - 1), [n - 1]]
-        cols_ = [np.tile(self.cols, (1, width)).ravel(), nd + gc.row, gc.col, np.full(k, n - 1), nd + right, [n - 1]]
-        self.fixed = np.r_[-gc.data, gc.data, -g_unit]
-        key = np.concatenate(cols_).astype(np.int64) * n + np.concatenate(rows).astype(np.int64)
-        unique, self.slot = np.unique(key, return_inverse=True)
-        self.indices = (unique % n).astype(np.int32)
-        self.indptr = np.r_[0, np.cumsum(np.bincount(unique // n, minlength=n))].astype(np.int32)
-        self.n, self.nnz = n, len(unique)
-
-    def __call__(self, weighted_tangent: np.ndarray, border: np.ndarray, border_u: float) -> sp.csc_matrix:
-        """The matrix for blocks V_q T_q, shape ``(m, 3, 3)``, and the border row (c, c_u)."""
-        k_loc = np.matmul(self.local.transpose(0, 2, 1), np.matmul(weighted_tangent, self.local))
-        values = np.concatenate([k_loc.ravel(), self.fixed, border, [border_u]])
-        data = np.bincount(self.slot, values, self.nnz)
-        return sp.csc_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
-
-
 def load_path(s: Strip, model: dm.DamageModel, targets: np.ndarray, snapshots: Sequence[float] = (),
-              energy_step: float | None = None, rtol: float = 1e-10, max_iterations: int = 25) -> LoadPath:
+              energy_step: float | None = None, rtol: float = 1e-10, max_iterations: int = 24, comm=None,
+              checkpoint_every: int = 0, checkpoint_dir: Path | None = None, resume: Path | None = None) -> LoadPath:
     """Quasi-static path through the tip displacements ``targets`` (and ``snapshots``).
 
-    Newton's method on the equilibrium f_int(d) = G^T mu with the collocation constraints
-    G d = u_T g (unknowns d, mu) under displacement control, or with u_T a further unknown and
-    the dissipation constraint (F_0 Delta u - u_0 Delta F) / 2 = tau through snap-backs
-    (``rkfx.damage.march``); the force is F = t sum mu_right.
+    ``rkfx.solvers.quasi_static.march`` on the ``DamageBarModel``: displacement control, and
+    dissipation control (F_0 Delta u - u_0 Delta F) / 2 = tau through snap-backs; the force is
+    F = t sum mu_right.
 
     Args:
         s: The discretization.
@@ -329,75 +185,27 @@ def load_path(s: Strip, model: dm.DamageModel, targets: np.ndarray, snapshots: S
         snapshots: Tip displacements at which stress and damage are recorded.
         energy_step: First dissipation step of the snap-back control [J] (default G_F A / 50).
         rtol: Residual tolerance relative to f_t H (forces per unit thickness).
-        max_iterations: Newton iterations per step before it is cut.
+        max_iterations: Newton iterations (linear solves) per step before it is cut.
+        comm: Communicator of the linear solves.
+        checkpoint_every, checkpoint_dir, resume: Checkpoints every so many accepted steps
+            into ``checkpoint_dir``; continue from the checkpoint folder ``resume``.
     """
     t0 = time.perf_counter()
-    nd, k = s.b.shape[1], s.g.shape[0]
-    v = model.volume
-    tol = rtol * model.material.ft * s.H
-    cur = {"d": np.zeros(nd), "mu": np.zeros(k), "u": 0.0, "state": dm.initial_state(model), "its": 0}
-    hist = {key: [0.0] for key in ("u", "force", "cod", "dissipated", "elastic")}
-    snaps = {}
-    pending = sorted(snapshots)
-    e_right = np.zeros(k)
-    e_right[s.right] = s.thickness
-    matrix = _NewtonMatrix(s.b, s.g, s.g_unit, s.right)
-    bt, gt = s.b.T.tocsr(), s.g.T.tocsr()
-
-    def newton(u_target, tau):
-        """One step: displacement control (tau None) or dissipation control (tau)."""
-        d, mu, u, state = cur["d"].copy(), cur["mu"].copy(), cur["u"], cur["state"]
-        u0, f0 = cur["u"], float(e_right @ cur["mu"])
-        if tau is None:
-            u = u_target
-            border, border_u = np.zeros(len(s.right)), 1.0
-        else:
-            border, border_u = -0.5 * u0 * e_right[s.right], 0.5 * f0
-        for it in range(max_iterations):
-            eps = (s.b @ d).reshape(-1, 3)
-            upd = dm.update(model, state, eps, tangent_floor=TANGENT_FLOOR,
-                            loading_tolerance=1e-9 if tau is None else 1e-3)
-            r = bt @ (v[:, None] * upd.stress).ravel() - gt @ mu
-            cres = s.g @ d - u * s.g_unit
-            force = float(e_right @ mu)
-            arc = 0.0 if tau is None else 0.5 * (f0 * (u - u0) - u0 * (force - f0)) - tau
-            if it > 0 and np.abs(r).max() <= tol and np.abs(cres).max() <= 1e-12 * max(abs(u), 1e-300) \
-                    and abs(arc) <= 1e-9 * (tau or 1.0):
-                if tau is not None and not 0.0 < upd.dissipation <= 3.0 * tau:
-                    return None  # the constraint's secant estimate met a far branch: cut tau
-                cur["its"] += it
-                return _Trial(u, force, d, mu, upd, eps, float(np.max(upd.state.damage - state.damage)), it)
-            jac = matrix(v[:, None, None] * upd.tangent, border, border_u)
-            try:
-                step = spla.splu(jac).solve(-np.r_[r, cres, arc])
-            except RuntimeError:  # exactly singular (e.g. a degenerate dissipation constraint)
-                return None
-            if not np.all(np.isfinite(step)):
-                return None
-            d, mu, u = d + step[:nd], mu + step[nd:nd + k], u + step[-1]
-        return None
-
-    def accept(trial):
-        cur["d"], cur["mu"], cur["u"], cur["state"] = trial.d, trial.mu, trial.u, trial.update.state
-        st, eps, sig = trial.update.state, trial.strain, trial.update.stress
-        hist["u"].append(trial.u)
-        hist["force"].append(trial.force)
-        hist["cod"].append(float(np.sum(st.damage * eps[:, 0] * v)) / s.H)
-        hist["dissipated"].append(float(st.dissipated.sum()) * s.thickness)
-        hist["elastic"].append(0.5 * float(np.sum(v[:, None] * sig * eps)) * s.thickness)
-        while pending and trial.u >= pending[0] * (1 - 1e-12):
-            snaps[pending.pop(0)] = (sig.copy(), st.damage.copy())
-
-    # tau is per unit thickness inside the model (energies are reported times the thickness).
-    mat = model.material
-    tau = (mat.GF * s.H / 50.0 if energy_step is None else energy_step / s.thickness)
+    bar = DamageBarModel(s, model)
+    curve = LoadCurve(bar, s.thickness, s.H, snapshots)
+    # As the documented paths were computed: tau is G_F A / 50 divided by the thickness t while
+    # the dissipation row measures (F_0 du - u_0 dF) / 2 with the whole force F = t sum mu_right,
+    # so a step dissipates G_F A / (50 t) in all (and the rejection test 0 < D <= 3 tau compares
+    # the dissipation per unit thickness with it).
+    tau = model.material.GF * s.H / 50.0 if energy_step is None else energy_step / s.thickness
+    stepper = QuasiStatic(NewtonOptions(max_iterations=max_iterations), rtol=rtol, energy_step=tau)
     all_targets = np.unique(np.r_[np.asarray(targets, float), np.asarray(snapshots, float)])
-    count = dm.march(all_targets, lambda u: newton(u, None), accept, arc=lambda t: newton(None, t),
-                     energy_step=tau)
-    arrays = {key: np.array(val) for key, val in hist.items()}
-    return LoadPath(**arrays, snapshots=snaps, state=cur["state"], coefficients=cur["d"], multipliers=cur["mu"],
-                iterations=cur["its"], cuts=count["cuts"], arc_steps=count["arc_steps"],
-                wall_time_s=time.perf_counter() - t0)
+    setup = time.perf_counter() - t0
+    out = march(bar, all_targets, stepper, recorder=curve, comm=comm, checkpoint_every=checkpoint_every,
+                checkpoint_dir=checkpoint_dir, resume=resume)
+    return LoadPath(**curve.series(), snapshots={u: v[:2] for u, v in curve.snapshots.items()}, state=bar.committed,
+                    coefficients=out.x, multipliers=out.mu, iterations=out.iterations, cuts=out.cuts,
+                    arc_steps=out.arc_steps, wall_time_s=setup + out.wall_time_s)
 
 
 def weak_points(s: Strip, L: float) -> np.ndarray:
@@ -475,11 +283,21 @@ def _reference(u, prm) -> dict:
     return {"F_czm": czm_force(u, L, A, E, GF, ft), "w_czm": czm_opening(u, L, A, E, GF, ft)}
 
 
-def _run_scni(label, s, model, targets, prm, info, stress_u=None) -> Run:
+def _io(label: str, io: dict) -> dict:
+    """The checkpoint arguments of one load path: its folder ``label`` (spaces and '=' dropped)
+    under the work directory, and the checkpoint to resume from if the interrupted run left one."""
+    key = label.replace(" ", "_").replace("=", "")
+    resume = io.get("resume")
+    resume = Path(resume) / key if resume is not None and (Path(resume) / key / CHECKPOINT).is_file() else None
+    every, work = io.get("checkpoint_every", 0), io.get("work_dir")
+    return {"checkpoint_every": every, "checkpoint_dir": None if work is None else Path(work) / key, "resume": resume}
+
+
+def _run_scni(label, s, model, targets, prm, info, stress_u=None, io=None) -> Run:
     """One SCNI load path with its curves, profile at u_T = w_c and (optionally) stresses."""
     wc = 2 * prm["GF"] / prm["ft"]
     snapshots = [wc] + ([stress_u] if stress_u is not None else [])
-    path = load_path(s, model, targets, snapshots)
+    path = load_path(s, model, targets, snapshots, **_io(label, io or {}))
     if model.regularized:
         dm.check_regularization(model, path.state)
     errors = _curve_errors(path.u, path.force, path.dissipated, path.elastic, prm)
@@ -497,7 +315,7 @@ def _run_scni(label, s, model, targets, prm, info, stress_u=None) -> Run:
     return Run(label, path.wall_time_s, 2 * s.p.num_nodes, series, errors, info)
 
 
-def _run_gauss(n, prm, stress_u, targets) -> Run:
+def _run_gauss(n, prm, stress_u, targets, io=None) -> Run:
     """Fig 4.11 (a): the Gauss-integrated solve up to the snapshot displacement."""
     L, A, E, GF, ft = (prm[k] for k in ("L", "A", "E", "GF", "ft"))
     s = gauss_strip(L, A, n, prm["support_factor"])
@@ -507,23 +325,31 @@ def _run_gauss(n, prm, stress_u, targets) -> Run:
     model = dm.damage_model(material, s.volume, np.where(weak, prm["weak_factor"], 1.0),
                             kappa_c=material.critical_opening / h, regularized=False)
     t0 = time.perf_counter()
+    label = f"rkpm-gauss{GAUSS_ALONG}x{GAUSS_ACROSS} n={n}"
     try:
-        path = load_path(s, model, targets[targets < stress_u], [stress_u])
+        path = load_path(s, model, targets[targets < stress_u], [stress_u], **_io(label, io or {}))
         sig, reached, its = path.snapshots[stress_u][0][:, 0], stress_u, path.iterations
     except SolverError:  # the seed: Gauss stresses "could ... cause divergence"
         sig, reached, its = np.full(len(s.points), np.nan), float("nan"), 0
     mean = np.nanmean(sig)
     errors = {"stress_max_dev": float(np.nanmax(np.abs(sig - mean)) / abs(mean))}
     series = {"stress_x": s.points[:, 0], "stress": sig, "stress_u": reached}
-    return Run(f"rkpm-gauss{GAUSS_ALONG}x{GAUSS_ACROSS} n={n}", time.perf_counter() - t0, 2 * s.p.num_nodes, series,
+    return Run(label, time.perf_counter() - t0, 2 * s.p.num_nodes, series,
                errors, {"study": "stress", "nodes": n, "cells": "gauss", "iterations": its})
 
 
 def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=2.0e6, GF=1.885, ft=200.0, L=100.0, A=10.0,
         nodes=(16, 32, 64, 128), weak_factor=0.999, steps=100, u_end=1.02, stress_at=0.2, support_factor=1.5,
-        cells=CELLS) -> Results:
-    """Regularized and unregularized SCNI models, the Gauss vs SCNI stresses, and crack-band FEM."""
+        cells=CELLS, checkpoint_every=0, work_dir=None, resume=None) -> Results:
+    """Regularized and unregularized SCNI models, the Gauss vs SCNI stresses, and crack-band FEM.
+
+    ``checkpoint_every`` accepted steps each load path writes a checkpoint into its folder of
+    ``work_dir`` (and one when it ends); ``resume`` (the work directory of an interrupted run)
+    reads finished paths back from their last checkpoint and continues the interrupted one."""
     nodes, cells = [int(n) for n in nodes], list(cells)
+    if checkpoint_every and work_dir is None:
+        raise InputError("checkpoint_every needs a work directory (the case's --out)")
+    io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume}
     _check(E, GF, ft, L, A, nodes, weak_factor, steps, u_end, stress_at, support_factor, cells)
     material = dm.DamageMaterial(E, 0.0, ft, GF, "stress")
     wc = material.critical_opening
@@ -559,9 +385,9 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=2.0e6, GF=1.885, ft=200.0
                 stress_u = u_peak + stress_at * (wc - u_peak) if regularized else None
                 add(key, n, _run_scni(f"{key} n={n}", s, model, targets, prm,
                                       {"study": "regularized" if regularized else "unregularized", "nodes": n,
-                                       "cells": cell_kind}, stress_u))
+                                       "cells": cell_kind}, stress_u, io))
                 if regularized and cell_kind == "voronoi":
-                    results.runs.append(_run_gauss(n, prm, stress_u, targets))
+                    results.runs.append(_run_gauss(n, prm, stress_u, targets, io))
     if "fem" in methods:
         import dolfinx_solver  # noqa: F401, PLC0415
 
@@ -570,7 +396,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=2.0e6, GF=1.885, ft=200.0
         for n in _cli.progress(nodes, "fem-crack-band"):
             u_peak = weak_factor * ft * L / E
             res = solve_crack_band(L, A, E, GF, ft, n - 1, _targets(u_peak, wc, steps, u_end, weak_factor),
-                                   weak_factor=weak_factor, u_profile=wc)
+                                   weak_factor=weak_factor, u_profile=wc, **_io(f"fem-crack-band n={n}", io))
             errors = _curve_errors(res.u, res.force, res.dissipated, res.elastic, prm)
             col_of = np.round(res.x / res.h - 0.5).astype(int)  # triangle centroids at 1/3 and 2/3 of a column
             column = np.arange(col_of.max() + 1)
@@ -726,7 +552,7 @@ def plot(results: Results, out: Path) -> list[Path]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point (see the module docstring)."""
-    return _cli.main(NAME, __doc__, PARAMS, run, plot, argv, QUICK)
+    return _cli.main(NAME, __doc__, PARAMS, run, plot, argv, QUICK, checkpoints=True)
 
 
 if __name__ == "__main__":
