@@ -163,6 +163,7 @@ class LinearSolver:
         self.mat.zeroEntries()
         self.mat.setValuesCSR(*_owned_rows(_sorted_csr(a), self.mat))
         self.mat.assemble()
+        self._norm = self.mat.norm(PETSc.NormType.NORM_INFINITY)
         self.ksp.setOperators(self.mat)
 
     def destroy(self) -> None:
