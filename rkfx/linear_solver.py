@@ -3,6 +3,8 @@
 The core stays importable without PETSc; with ``rkfx[fem]`` installed every solve goes through
 ``rkfx.petsc`` (MUMPS LU by default, distributed over the communicator's ranks).
 """
+from collections.abc import Mapping
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -29,15 +31,16 @@ class _ScipyLU:
         pass
 
 
-def linear_solver(a: sp.spmatrix, comm=None, solver: str = "mumps"):
-    """An object with ``.solve(b)`` and ``.destroy()`` for the matrix ``a``."""
+def linear_solver(a: sp.spmatrix, comm=None, solver: str = "mumps", mumps_icntl: Mapping[int, int] | None = None):
+    """An object with ``.solve(b)`` and ``.destroy()`` for the matrix ``a`` (``mumps_icntl``:
+    further MUMPS controls, see ``rkfx.petsc.make_ksp``; ignored without PETSc)."""
     try:
         from . import petsc  # noqa: PLC0415
     except ImportError:
         if solver != "mumps":
             raise InputError(f"solver {solver!r} needs PETSc: pip install 'rkfx[fem]'") from None
         return _ScipyLU(a)
-    return petsc.LinearSolver(a, comm if comm is not None else petsc.MPI.COMM_WORLD, solver)
+    return petsc.LinearSolver(a, comm if comm is not None else petsc.MPI.COMM_WORLD, solver, mumps_icntl)
 
 
 class Factorizations:
@@ -52,10 +55,16 @@ class Factorizations:
         comm: Communicator (PETSc when installed).
         solver: ``mumps``, ``gmres-ilu`` or ``cg-gamg`` (see ``rkfx.petsc``).
         keep: Factorizations kept at once (the oldest is freed first).
+        mumps_icntl: Further MUMPS controls, e.g. ``{7: 2}`` for the AMF ordering.
+        reuse_analysis: A keyed matrix that takes the place of the oldest one when ``keep``
+            are cached, with its sparsity pattern (a new step size of a linear model), is
+            refactorized in that solver's objects like an unkeyed one.
     """
 
-    def __init__(self, comm=None, solver: str = "mumps", keep: int = 5):
-        self.comm, self.solver, self.keep = comm, solver, int(keep)
+    def __init__(self, comm=None, solver: str = "mumps", keep: int = 5, mumps_icntl: Mapping[int, int] | None = None,
+                 reuse_analysis: bool = False):
+        self.comm, self.solver, self.keep, self.mumps_icntl = comm, solver, int(keep), mumps_icntl
+        self.reuse_analysis = reuse_analysis
         self._cache: dict = {}
         self.count = 0  # factorizations made
         # Set-up that steppers reuse from step to step of one run (keyed by the stepper).
@@ -66,12 +75,19 @@ class Factorizations:
         if key is not None and key in self._cache:
             return self._cache[key]
         a = build()
-        last = self._cache.get(None) if key is None else None
-        if last is not None and last.matches(a):
-            last.refactor(a)
+        # The solver whose objects and analysis the matrix may take: the last unkeyed one or,
+        # with reuse_analysis, the oldest keyed one, which is about to be freed.
+        reusable = key is None or (self.reuse_analysis and len(self._cache) >= self.keep)
+        old = None if key is None else next(iter(self._cache), None)
+        spare = self._cache.get(old) if reusable else None
+        if spare is not None and spare.matches(a):
+            spare.refactor(a)
             self.count += 1
-            return last
-        ls = linear_solver(a, self.comm, self.solver)
+            if key is not None:  # the freed key's solver now serves this one
+                del self._cache[old]
+                self._cache[key] = spare
+            return spare
+        ls = linear_solver(a, self.comm, self.solver, self.mumps_icntl)
         self.count += 1
         if key is None:
             self._drop(None)

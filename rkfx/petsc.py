@@ -6,6 +6,7 @@ function takes an MPI communicator. Matrices are distributed by contiguous row b
 holds, so the same code runs serially and under ``mpiexec -n P``.
 """
 import warnings
+from collections.abc import Mapping
 
 import dolfinx_solver  # noqa: F401  (orders MPI before petsc4py)
 import numpy as np
@@ -60,13 +61,17 @@ def to_petsc_vec(v: np.ndarray, mat: PETSc.Mat) -> PETSc.Vec:
 def gather(vec: PETSc.Vec) -> np.ndarray:
     """The whole vector on every rank."""
     comm = vec.getComm().tompi4py()
+    if comm.size == 1:
+        return vec.array_r.copy()
     return np.concatenate(comm.allgather(vec.array_r.copy()))
 
 
-def make_ksp(mat: PETSc.Mat, solver: str = "mumps", rtol: float = 1e-12, prefix: str = "rkfx_") -> PETSc.KSP:
+def make_ksp(mat: PETSc.Mat, solver: str = "mumps", rtol: float = 1e-12, prefix: str = "rkfx_",
+             mumps_icntl: Mapping[int, int] | None = None) -> PETSc.KSP:
     """A KSP for ``mat``: MUMPS LU (default), GMRES with ILU/ASM, or CG with GAMG.
 
-    PETSc options given with ``-rkfx_...`` on the command line refine the choice.
+    ``mumps_icntl`` sets further MUMPS controls, e.g. ``{7: 2}`` for the AMF ordering. PETSc
+    options given with ``-rkfx_...`` on the command line refine the choice.
     """
     if solver not in SOLVERS:
         raise InputError(f"unknown linear solver {solver!r}; choose one of {', '.join(SOLVERS)}")
@@ -85,6 +90,8 @@ def make_ksp(mat: PETSc.Mat, solver: str = "mumps", rtol: float = 1e-12, prefix:
         factor.setMumpsIcntl(14, 200)
         # Detect null pivots so that a singular system is reported, not "solved".
         factor.setMumpsIcntl(24, 1)
+        for key, value in (mumps_icntl or {}).items():
+            factor.setMumpsIcntl(key, value)
     elif solver == "gmres-ilu":
         ksp.setType("gmres")
         pc.setType("asm" if mat.getComm().size > 1 else "ilu")
@@ -105,12 +112,13 @@ class LinearSolver:
     raise ``SolverDiverged``.
     """
 
-    def __init__(self, a: sp.spmatrix, comm=MPI.COMM_WORLD, solver: str = "mumps"):
+    def __init__(self, a: sp.spmatrix, comm=MPI.COMM_WORLD, solver: str = "mumps",
+                 mumps_icntl: Mapping[int, int] | None = None):
         self.solver = solver
         a = _sorted_csr(a)
         self.pattern = (a.shape, a.indptr.copy(), a.indices.copy())
         self.mat = to_petsc_mat(a, comm)
-        self.ksp = make_ksp(self.mat, solver)
+        self.ksp = make_ksp(self.mat, solver, mumps_icntl=mumps_icntl)
         self.rhs = self.mat.createVecLeft()
         self.x = self.mat.createVecRight()
         self.residual = self.mat.createVecLeft()

@@ -302,10 +302,12 @@ class _NewmarkSystem:
             j, gt = _scale_rows(j, self.W), _scale_rows(gt, self.W)
         if self.G.shape[0] == 0:
             return j.tocsr()
-        return sp.bmat([[j, gt], [self.Gw, None]], format="csr")
+        k = self.G.shape[0]  # all blocks CSR: scipy stacks them without converting to COO
+        return sp.bmat([[sp.csr_matrix(j), sp.csr_matrix(gt)], [sp.csr_matrix(self.Gw), sp.csr_matrix((k, k))]],
+                       format="csr")
 
     def jacobian_key(self):
-        return ("newmark", round(self.co.dt, 12)) if self.model.linear else None
+        return ("newmark", step_key(self.co.dt)) if self.model.linear else None
 
     def converged(self, z, r, iteration):
         st = self.stepper
@@ -319,6 +321,12 @@ class _NewmarkSystem:
         ok_eq = (np.abs(eq).max() if eq.size else 0.0) <= st.atol + st.rtol * max(self.r0, self.scale)
         ok_con = (np.abs(con).max() if con.size else 0.0) <= st.ctol * self.gscale
         return bool(ok_eq and ok_con)
+
+
+def step_key(dt: float) -> float:
+    """dt to 10 significant digits: steps of one size taken as differences of step times, which
+    differ in their last bits (by about 1e-16 t), share a key whatever the unit of time."""
+    return float(f"{dt:.10g}")
 
 
 def _scale_columns(a: sp.csr_matrix, scale: np.ndarray) -> sp.csr_matrix:
