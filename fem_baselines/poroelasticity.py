@@ -21,7 +21,7 @@ White & Borja (2008) as the seed writes it in eqs. 3.49-3.52,
 ``S = int eps_f (psi - Pi psi)(p - Pi p)`` with ``Pi`` the cell-wise L2 projection onto constants
 and ``eps_f`` from eqs. 3.53-3.54 (``h = sqrt(cell area)``). It is assembled exactly as
 ``S = M_eps - C diag(eps_f / |K|) C^T`` (``M_eps`` the eps_f-weighted Q1 mass matrix, ``C`` the
-Q1 x DG0 mixed mass matrix), the second term by PETSc sparse products.
+Q1 x DG0 mixed mass matrix).
 
 Two FPP variants (``fpp_form``): ``"seed"`` is eq. 3.51 literally (``-dt S`` in the p-p block);
 ``"rate"`` is White & Borja's original, where the term acts on the pressure rate
@@ -31,11 +31,14 @@ Terzaghi column at c dt / h^2 = 0.1 (dt = 6250 s) it suppresses the undrained pr
 0.53 p0), and on the seed's Mandel set-up (dt = 4e-4) it has no visible effect; the rate form is
 unit-invariant and removes the Q1-Q1 oscillations in both (see tests/test_fem_poroelasticity.py).
 
-Implementation: the dt-independent part of the monolithic matrix is assembled once (a dolfinx
-nest converted to AIJ; rows ``[u owned, p owned]`` per rank, the layout of
-``dolfinx.fem.petsc.create_vector([V, Q], kind="mpi")``); the dt-dependent p-p part (``-dt K_H``
-and FPP) is assembled on the pressure space and added through an injection matrix, then
-factorised with MUMPS LU once per distinct dt.
+Implementation: dolfinx assembly plugs into the shared solvers of ``rkfx.solvers`` as a model
+(:class:`FemBiotModel`): the blocks are assembled once by dolfinx (FPP once per step size) and
+gathered into scipy CSR on every rank in the global numbering ``[u, p]``, the Dirichlet
+conditions are constraint rows with their values at t, and :func:`solve_biot` steps the model
+with ``rkfx.solvers.integrate`` and ``backward_euler()``: one Newton iteration per step and one
+MUMPS factorisation per distinct dt through ``rkfx.linear_solver.Factorizations`` (a new dt
+reuses the ordering of the matrix it replaces), with checkpoints and resume. The matrix is
+held whole on every rank and its rows distributed to MUMPS by ``rkfx.petsc``.
 
 Elements: ``"taylor-hood"`` (P2-P1 on triangles, Q2-Q1 on quadrilaterals; inf-sup stable),
 ``"q1q1"`` (equal-order Q1-Q1 on quadrilaterals, P1-P1 on triangles; unstabilised, oscillates
@@ -47,19 +50,18 @@ no side effects beyond importing dolfinx (``dolfinx_solver`` first, as it must b
 
 from __future__ import annotations
 
-import itertools
 import time
-from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import dolfinx_solver  # noqa: F401  (must precede dolfinx / petsc4py: orders MPI loading)
 
 import basix.ufl
 import numpy as np
+import scipy.sparse as sp
 from mpi4py import MPI
-from petsc4py import PETSc
 
 import dolfinx
 import dolfinx.fem
@@ -69,9 +71,16 @@ import dolfinx.la
 import dolfinx.mesh
 import ufl
 
+from rkfx.linear_solver import Factorizations
+from rkfx.solvers.fields import Field, FieldLayout
+from rkfx.solvers.integrate import integrate
+from rkfx.solvers.model import Constraints
+from rkfx.solvers.newmark import StepState, backward_euler, step_key
+
 __all__ = [
     "BiotResult",
     "Displacement",
+    "FemBiotModel",
     "Flux",
     "Pressure",
     "Traction",
@@ -87,21 +96,9 @@ BoundaryKey = str | Callable[[np.ndarray], np.ndarray]
 
 ELEMENTS = ("taylor-hood", "q1q1", "q1q1-fpp")
 
-_prefix_counter = itertools.count()
-
-_MUMPS_OPTIONS = {
-    "ksp_type": "preonly",
-    "pc_type": "lu",
-    "pc_factor_mat_solver_type": "mumps",
-    # Saddle-point systems: MUMPS' default workspace estimate can be too small (INFOG(1) = -9).
-    "mat_mumps_icntl_14": 200,
-    # AMF ordering: 1.7x faster factorisations than the default on the Mandel Taylor-Hood system.
-    "mat_mumps_icntl_7": 2,
-}
-
-#: Number of factorised systems (one per distinct time step) kept alive at once.
-_CACHE_SIZE = 2
-
+#: MUMPS controls beyond ``rkfx.petsc``'s: the AMF ordering (ICNTL(7) = 2) factorises the
+#: Mandel Taylor-Hood system 4x faster than the default.
+_MUMPS_ICNTL = {7: 2}
 
 # --------------------------------------------------------------------------- boundary data
 
@@ -182,11 +179,11 @@ class BiotResult:
         p_h: Final pressure, a scalar Lagrange Function (ghosts up to date).
         element: The element name used.
         n_steps: Number of time steps taken.
-        n_factorizations: Number of distinct matrices assembled and factorised.
+        n_factorizations: Number of matrices factorised (one per distinct time step).
         timings: Wall-clock breakdown [s], max over ranks: ``"setup"`` (spaces, forms incl.
-            JIT, everything before the first step), ``"matrix"`` (assembly, FPP products and
-            MUMPS factorisation, per distinct dt), ``"solve"`` (data interpolation, RHS
-            assembly, triangular solves), ``"sample"`` (point evaluation).
+            JIT, assembly, everything before the first step), ``"steps"`` (the time loop:
+            data at t, FPP per distinct dt, factorisations and solves), ``"sample"`` (point
+            evaluation).
     """
 
     output_times: np.ndarray
@@ -377,6 +374,311 @@ def _facet_tags(mesh: dolfinx.mesh.Mesh, keys: Sequence[BoundaryKey], what: str)
     return dolfinx.mesh.meshtags(mesh, fdim, facets, values)
 
 
+# --------------------------------------------------------------------------- the model
+
+
+def _gather(comm: MPI.Comm, owned: np.ndarray) -> np.ndarray:
+    """The owned parts of a distributed array, concatenated in rank order: the global array."""
+    return np.concatenate(comm.allgather(np.ascontiguousarray(owned))) if comm.size > 1 else owned.copy()
+
+
+def _global_matrix(form: dolfinx.fem.Form, comm: MPI.Comm) -> sp.csr_matrix:
+    """A bilinear form assembled by dolfinx (PETSc AIJ, rows by owner) as one scipy CSR on every rank."""
+    A = dolfinx.fem.petsc.assemble_matrix(form)
+    A.assemble()
+    indptr, indices, data = A.getValuesCSR()
+    (lo, hi), (_, n_cols) = A.getOwnershipRange(), A.getSize()
+    A.destroy()
+    local = sp.csr_matrix((data, indices, indptr), shape=(hi - lo, n_cols))
+    return sp.vstack(comm.allgather(local), format="csr") if comm.size > 1 else local
+
+
+def _global_vector(form: dolfinx.fem.Form, comm: MPI.Comm) -> np.ndarray:
+    """A linear form assembled by dolfinx as one global array on every rank."""
+    b = dolfinx.fem.assemble_vector(form)
+    b.scatter_reverse(dolfinx.la.InsertMode.add)
+    return _gather(comm, b.array[: b.index_map.size_local * b.block_size])
+
+
+def _in_order(comm: MPI.Comm, parts: list[np.ndarray]) -> np.ndarray:
+    """Per-part arrays of every rank concatenated part by part, ranks in order within a part."""
+    ranks = comm.allgather(parts) if comm.size > 1 else [parts]
+    return np.concatenate([np.zeros(0)] + [r[i] for i in range(len(parts)) for r in ranks])
+
+
+class FemBiotModel:
+    """Biot's u-p equations assembled by dolfinx, as a model for the steppers of ``rkfx.solvers``.
+
+    The unknowns, the same on every rank, are ``[u, p]`` in dolfinx's global dof numbering: u
+    interleaved per node of the displacement space V, then p per node of Q; both of time order
+    1 (u is quasi-static; its rate enters the storage equation). As in
+    ``rkfx.poroelasticity.BiotModel``, C x' + r(x, t) = 0 with
+
+        r = [K_uu u - K_up p - F(t), K_H p - Q(t)],   C(dt) = [[0, 0], [K_up^T, K_S + S(dt)]],
+
+    K_up = int alpha div(v) p, F = int t . v ds, Q = -int (q . n) psi ds and S(dt) the FPP term
+    ``M_eps - C diag(eps_f / |K|) C^T`` (``element="q1q1-fpp"``) with eps_f of the step size.
+    ``fpp_form="seed"`` moves S(dt) from C into K (eq. 3.51 as printed); its step size is the
+    one from the committed time, which is this model's history. The storage rows are weighted
+    by -theta dt, so that backward Euler's Jacobian is the symmetric matrix of eq. 3.43.
+
+    The blocks are assembled once (S per step size) by dolfinx into PETSc and gathered into
+    scipy CSR on every rank; the loads and Dirichlet data are evaluated at t. Dirichlet
+    conditions are unit rows G x = g(t) on their dofs (a dof named by several conditions takes
+    the last one's value, as dolfinx's ``set_bc``).
+
+    Args: as :func:`solve_biot`.
+    """
+
+    def __init__(self, mesh: dolfinx.mesh.Mesh, E: float, nu: float, k: float, alpha: float, S: float,
+                 element: str, bcs: Sequence[BoundaryCondition], fpp_form: str = "rate", t0: float = 0.0):
+        self.comm, self.material = mesh.comm, (E, nu, k, alpha, S)
+        mesh.topology.create_connectivity(mesh.topology.dim - 1, mesh.topology.dim)
+        self._degree = 2 if element == "taylor-hood" else 1  # of u
+        self.V = dolfinx.fem.functionspace(mesh, ("Lagrange", self._degree, (2,)))
+        self.Q = dolfinx.fem.functionspace(mesh, ("Lagrange", 1))
+        # Local (owned + ghost) dofs -> global unknowns.
+        v_map, q_map = self.V.dofmap.index_map, self.Q.dofmap.index_map
+        v_nodes = v_map.local_to_global(np.arange(v_map.size_local + v_map.num_ghosts, dtype=np.int32))
+        self._n_u = 2 * v_map.size_global
+        self.u_index = (2 * v_nodes[:, None] + np.arange(2)).ravel()
+        self.p_index = self._n_u + q_map.local_to_global(np.arange(q_map.size_local + q_map.num_ghosts,
+                                                                   dtype=np.int32))
+        self.layout = FieldLayout((Field("u", 2, 1, v_map.size_global), Field("p", 1, 1, q_map.size_global)))
+        self.linear = True
+        self.fpp = element == "q1q1-fpp"
+        self.seed = self.fpp and fpp_form == "seed"
+        self._assemble(mesh)
+        self._natural_conditions(mesh, bcs)
+        self._essential_conditions(mesh, bcs)
+        self._t = float(t0)  # committed time (the seed form's step starts there)
+        self._t_trial = self._t
+        self._at: dict[str, tuple[float, Any]] = {}  # loads and constraints at the last t
+        self._per_dt: dict[tuple[str, float], Any] = {}
+
+    def _assemble(self, mesh: dolfinx.mesh.Mesh) -> None:
+        """K, C without FPP, and what FPP needs per step size."""
+        E, nu, k, alpha, S = self.material
+        comm, n_u = self.comm, self._n_u
+
+        def constant(value):  # a Constant, not a literal: one compiled form for all parameters
+            return dolfinx.fem.Constant(mesh, dolfinx.default_scalar_type(value))
+
+        def eps(w):
+            return ufl.sym(ufl.grad(w))
+
+        lam, mu = constant(E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))), constant(E / (2.0 * (1.0 + nu)))
+        u, v = ufl.TrialFunction(self.V), ufl.TestFunction(self.V)
+        p, q = ufl.TrialFunction(self.Q), ufl.TestFunction(self.Q)
+        dx = ufl.dx(domain=mesh)
+        sigma = lam * ufl.tr(eps(u)) * ufl.Identity(2) + 2.0 * mu * eps(u)
+        kuu = _global_matrix(dolfinx.fem.form(ufl.inner(sigma, eps(v)) * dx), comm)
+        kup = _global_matrix(dolfinx.fem.form(constant(alpha) * p * ufl.div(v) * dx), comm)
+        kh = _global_matrix(dolfinx.fem.form(constant(k) * ufl.inner(ufl.grad(p), ufl.grad(q)) * dx), comm)
+        n_p = kh.shape[0]
+        ks = _global_matrix(dolfinx.fem.form(constant(S) * p * q * dx), comm) if S > 0 else sp.csr_matrix((n_p, n_p))
+        self._K = sp.bmat([[kuu, -kup], [None, kh]], format="csr")
+        self._C = sp.bmat([[sp.csr_matrix((n_u, n_u)), None], [kup.T, ks]], format="csr")
+        if self.fpp:
+            DG0 = dolfinx.fem.functionspace(mesh, ("DG", 0))
+            self._eps_f = dolfinx.fem.Function(DG0, name="eps_f")
+            mu0 = ufl.TestFunction(DG0)
+            self._ct = _global_matrix(dolfinx.fem.form(p * mu0 * dx), comm)  # (cells, Q dofs)
+            area = dolfinx.fem.assemble_vector(dolfinx.fem.form(mu0 * dx))
+            area.scatter_reverse(dolfinx.la.InsertMode.add)
+            area.scatter_forward()
+            self._cell_area = area.array.copy()  # owned + ghost cells [m^2]
+            self._cell_area_global = _gather(comm, self._cell_area[: DG0.dofmap.index_map.size_local])
+            self._m_eps = dolfinx.fem.form(self._eps_f * p * q * dx)
+
+    def _natural_conditions(self, mesh: dolfinx.mesh.Mesh, bcs: Sequence[BoundaryCondition]) -> None:
+        """Forms of F(t) (tractions on a V-like space) and Q(t) (fluxes on P2), data Functions at t."""
+        self._load_data: list[tuple[dolfinx.fem.Function, Any, tuple[int, ...]]] = []
+        v, q = ufl.TestFunction(self.V), ufl.TestFunction(self.Q)
+        self._L_u = self._L_p = None
+        for kind, space, shape, term in ((Traction, ("Lagrange", self._degree, (2,)), (2,), lambda f: ufl.inner(f, v)),
+                                         (Flux, ("Lagrange", 2), (), lambda f: -f * q)):
+            parts = [bc for bc in bcs if isinstance(bc, kind)]
+            if not parts:
+                continue
+            what = kind.__name__.lower()
+            ds = ufl.Measure("ds", domain=mesh, subdomain_data=_facet_tags(mesh, [b.boundary for b in parts], what))
+            W = dolfinx.fem.functionspace(mesh, space)
+            forms = []
+            for i, bc in enumerate(parts):
+                fn = dolfinx.fem.Function(W)
+                self._load_data.append((fn, bc.value, shape))
+                forms.append(term(fn) * ds(i + 1))
+            form = dolfinx.fem.form(sum(forms[1:], forms[0]))
+            if kind is Traction:
+                self._L_u = form
+            else:
+                self._L_p = form
+
+    def _essential_conditions(self, mesh: dolfinx.mesh.Mesh, bcs: Sequence[BoundaryCondition]) -> None:
+        """Unit rows G on the owned dofs of each Dirichlet condition, data evaluated at their coordinates."""
+        fdim = mesh.topology.dim - 1
+        self._dirichlet = []  # (data, coordinates (3, m), global rows (m,)) of each condition
+        v_owned, q_owned = 2 * self.V.dofmap.index_map.size_local, self.Q.dofmap.index_map.size_local
+        v_points, q_points = self.V.tabulate_dof_coordinates(), self.Q.tabulate_dof_coordinates()
+        for bc in bcs:
+            if isinstance(bc, (Traction, Flux)):
+                continue
+            if not isinstance(bc, (Displacement, Pressure)):
+                raise TypeError(f"unknown boundary condition {bc!r}")
+            facets = dolfinx.mesh.locate_entities_boundary(mesh, fdim, _boundary_marker(bc.boundary, mesh))
+            if isinstance(bc, Displacement):
+                if bc.component not in (0, 1):
+                    raise ValueError(f"Displacement component must be 0 or 1, got {bc.component}")
+                dofs = dolfinx.fem.locate_dofs_topological(self.V.sub(bc.component), fdim, facets)  # unrolled
+                dofs = dofs[dofs < v_owned]
+                self._dirichlet.append((bc.value, v_points[dofs // 2].T, self.u_index[dofs]))
+            else:
+                dofs = dolfinx.fem.locate_dofs_topological(self.Q, fdim, facets)
+                dofs = dofs[dofs < q_owned]
+                self._dirichlet.append((bc.value, q_points[dofs].T, self.p_index[dofs]))
+        rows = _in_order(self.comm, [r for _, _, r in self._dirichlet]).astype(np.int64)
+        self._bc_rows, last = np.unique(rows[::-1], return_index=True)
+        self._bc_last = len(rows) - 1 - last  # where each constrained dof's value stands in the gathered list
+        k = len(self._bc_rows)
+        self._G = sp.csr_matrix((np.ones(k), (np.arange(k), self._bc_rows)), shape=(k, self.layout.size))
+        self._bc_values = [None] * len(self._dirichlet)  # on the owned dofs, at the last t
+
+    # ------------------------------------------------------------------ fields
+
+    @property
+    def num_constraints(self) -> int:
+        return self._G.shape[0]
+
+    def vector(self, uh: dolfinx.fem.Function, ph: dolfinx.fem.Function) -> np.ndarray:
+        """The global unknowns of (u_h, p_h)."""
+        n_v, n_q = self.V.dofmap.index_map.size_local, self.Q.dofmap.index_map.size_local
+        return np.concatenate([_gather(self.comm, uh.x.array[: 2 * n_v]), _gather(self.comm, ph.x.array[:n_q])])
+
+    def assign(self, x: np.ndarray, uh: dolfinx.fem.Function, ph: dolfinx.fem.Function) -> None:
+        """(u_h, p_h), ghosts included, from the global unknowns."""
+        uh.x.array[:] = x[self.u_index]
+        ph.x.array[:] = x[self.p_index]
+
+    # ------------------------------------------------------------------ data at t
+
+    def _cached(self, what: str, t: float, varies: bool, build):
+        hit = self._at.get(what)
+        if hit is None or (varies and hit[0] != t):
+            hit = self._at[what] = (t, build(t))
+        return hit[1]
+
+    def loads(self, t: float) -> np.ndarray:
+        """[F(t), Q(t)], shape ``(size,)``."""
+        def build(t):
+            first = "loads" not in self._at
+            for fn, data, shape in self._load_data:
+                if callable(data) or first:
+                    fn.interpolate(lambda X, data=data, shape=shape: _values(data, X, t, shape))
+            f = np.zeros(self.layout.size)
+            if self._L_u is not None:
+                f[: self._n_u] = _global_vector(self._L_u, self.comm)
+            if self._L_p is not None:
+                f[self._n_u:] = _global_vector(self._L_p, self.comm)
+            return f
+
+        return self._cached("loads", t, any(callable(d) for _, d, _ in self._load_data), build)
+
+    def constraints(self, t: float) -> Constraints:
+        def build(t):
+            self._bc_values = [_values(data, x, t, ()) if callable(data) or old is None else old
+                               for (data, x, _), old in zip(self._dirichlet, self._bc_values)]
+            return Constraints(self._G, _in_order(self.comm, self._bc_values)[self._bc_last])
+
+        return self._cached("constraints", t, any(callable(d) for d, _, _ in self._dirichlet), build)
+
+    # ------------------------------------------------------------------ matrices
+
+    def _memo(self, what: str, dt: float, build):
+        key = (what, step_key(dt))
+        if key not in self._per_dt:
+            if len(self._per_dt) > 8:
+                self._per_dt.pop(next(iter(self._per_dt)))
+            self._per_dt[key] = build(dt)
+        return self._per_dt[key]
+
+    def stabilization(self, dt: float) -> sp.csr_matrix:
+        """The FPP matrix S = M_eps - C diag(eps_f / |K|) C^T for steps of dt, shape ``(n_p, n_p)``."""
+        def build(dt):
+            E, nu, k, alpha, S = self.material
+            self._eps_f.x.array[:] = fpp_parameter(E, nu, k, alpha, S, dt, np.sqrt(self._cell_area))
+            eps = fpp_parameter(E, nu, k, alpha, S, dt, np.sqrt(self._cell_area_global))
+            projection = self._ct.T @ sp.diags(eps / self._cell_area_global) @ self._ct
+            return (_global_matrix(self._m_eps, self.comm) - projection).tocsr()
+
+        return self._memo("fpp", dt, build)
+
+    def _on_pressure(self, a: sp.csr_matrix) -> sp.csr_matrix:
+        """A p-p block as a matrix over all unknowns."""
+        a = sp.csr_matrix(a)
+        return sp.csr_matrix((a.data, a.indices + self._n_u, np.r_[np.zeros(self._n_u, a.indptr.dtype), a.indptr]),
+                             shape=(self.layout.size, self.layout.size))
+
+    def tangent(self, x: np.ndarray, t: float) -> sp.csr_matrix:
+        if not self.seed:
+            return self._K
+        return self._memo("K", t - self._t, lambda dt: self._K + self._on_pressure(self.stabilization(dt)))
+
+    def residual(self, x: np.ndarray, t: float) -> np.ndarray:
+        self._t_trial = t
+        return self.tangent(x, t) @ x - self.loads(t)
+
+    def mass(self) -> None:
+        return None
+
+    def capacity(self, dt: float) -> sp.csr_matrix:
+        if not self.fpp or self.seed:
+            return self._C
+        return self._memo("C", dt, lambda dt: self._C + self._on_pressure(self.stabilization(dt)))
+
+    def equation_weights(self, co) -> np.ndarray:
+        """-1 / (dp'/dp) on the storage rows: the symmetric Jacobian of eq. 3.43."""
+        return self._memo("W", co.dt, lambda dt: np.r_[np.ones(self._n_u),
+                                                       np.full(self.layout.size - self._n_u, -1.0 / co.dv[-1])])
+
+    # ------------------------------------------------------------------ history
+
+    def commit(self) -> None:
+        self._t = self._t_trial
+
+    def state(self) -> dict[str, np.ndarray]:
+        return {"t": np.float64(self._t)}
+
+    def restore(self, arrays) -> None:
+        self._t = self._t_trial = float(arrays["t"])
+
+
+class _Samples:
+    """Point values of (u, p) at the output steps, for ``rkfx.solvers.integrate``."""
+
+    def __init__(self, model: FemBiotModel, sampler: _Sampler, steps: np.ndarray,
+                 uh: dolfinx.fem.Function, ph: dolfinx.fem.Function):
+        self.model, self.sampler, self.steps, self.uh, self.ph = model, sampler, steps, uh, ph
+        m = sampler.x3.shape[0]
+        self.p = np.full((len(steps), m), np.nan)
+        self.u = np.full((len(steps), m, 2), np.nan)
+        self.seconds = 0.0
+
+    def record(self, s: StepState) -> None:
+        t0 = time.perf_counter()
+        for j in np.flatnonzero(self.steps == s.step):
+            self.model.assign(s.x, self.uh, self.ph)
+            self.p[j], self.u[j] = self.sampler(self.uh, self.ph)
+        self.seconds += time.perf_counter() - t0
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        return {"p": self.p, "u": self.u}
+
+    def restore(self, arrays) -> None:
+        self.p[...] = arrays["p"]
+        self.u[...] = arrays["u"]
+
+
 # --------------------------------------------------------------------------- solver
 
 
@@ -396,12 +698,16 @@ def solve_biot(
     initial_u: Callable[[np.ndarray], np.ndarray] | None = None,
     initial_p: Callable[[np.ndarray], np.ndarray] | None = None,
     fpp_form: str = "rate",
+    checkpoint_every: int = 0,
+    checkpoint_dir: str | Path | None = None,
+    resume: str | Path | None = None,
 ) -> BiotResult:
     """Solve plane-strain Biot consolidation with backward Euler and a monolithic u-p solve.
 
     Collective on the mesh communicator. Boundaries not mentioned in ``bcs`` are traction-free
-    and impermeable. Each linear system is factorised with MUMPS once per distinct time step
-    (matrices are cached by dt, the last two kept).
+    and impermeable. The :class:`FemBiotModel` is stepped by ``rkfx.solvers.integrate`` with
+    ``backward_euler()``: one Newton iteration per step, one MUMPS factorisation per distinct
+    time step.
 
     Args:
         mesh: A 2D dolfinx mesh (e.g. from :func:`rectangle_mesh`), triangles or quadrilaterals.
@@ -427,13 +733,18 @@ def solve_biot(
             consistent with eps_f in 1/Pa); ``"seed"``: ``-dt S`` in the p-p block as eq. 3.51
             is printed, which depends on the unit of time (kept for comparison). Ignored unless
             ``element == "q1q1-fpp"``.
+        checkpoint_every, checkpoint_dir: Write a checkpoint (state and samples so far) every
+            so many steps, and at the last one, into the folder. Every rank writes the whole
+            state: under MPI give each rank a folder of its own.
+        resume: A checkpoint folder to continue from (same mesh, data and times); the result
+            equals that of an uninterrupted run.
 
     Returns:
         The sampled history and final fields; see :class:`BiotResult`.
 
     Raises:
         ValueError: On inconsistent input.
-        RuntimeError: If a linear solve fails (KSP reason < 0).
+        rkfx.errors.SolverError: If a linear solve fails.
     """
     t_start = time.perf_counter()
     if comm is not None and comm.size != mesh.comm.size:
@@ -456,340 +767,43 @@ def solve_biot(
     if not (E > 0 and -1.0 < nu < 0.5 and k >= 0 and S >= 0):
         raise ValueError(f"need E > 0, -1 < nu < 0.5, k >= 0, S >= 0; got E={E}, nu={nu}, k={k}, S={S}")
 
-    tdim = mesh.topology.dim
-    fdim = tdim - 1
-    mesh.topology.create_connectivity(fdim, tdim)
-    deg_u = 2 if element == "taylor-hood" else 1
-    V = dolfinx.fem.functionspace(mesh, ("Lagrange", deg_u, (2,)))
-    Q = dolfinx.fem.functionspace(mesh, ("Lagrange", 1))
-    scalar = dolfinx.default_scalar_type
-
-    # -- Dirichlet conditions (data Functions re-interpolated at every t_n+1) ----------------
-    updates: list[tuple[dolfinx.fem.Function, Any, tuple[int, ...]]] = []
-    dirichlet: list[dolfinx.fem.DirichletBC] = []
-    p_dirichlet: list[dolfinx.fem.DirichletBC] = []
-    tractions = [bc for bc in bcs if isinstance(bc, Traction)]
-    fluxes = [bc for bc in bcs if isinstance(bc, Flux)]
-    for bc in bcs:
-        if isinstance(bc, (Traction, Flux)):
-            continue
-        if not isinstance(bc, (Displacement, Pressure)):
-            raise TypeError(f"unknown boundary condition {bc!r}")
-        facets = dolfinx.mesh.locate_entities_boundary(mesh, fdim, _boundary_marker(bc.boundary, mesh))
-        if isinstance(bc, Displacement):
-            if bc.component not in (0, 1):
-                raise ValueError(f"Displacement component must be 0 or 1, got {bc.component}")
-            Vc, _ = V.sub(bc.component).collapse()
-            g = dolfinx.fem.Function(Vc)
-            dofs = dolfinx.fem.locate_dofs_topological((V.sub(bc.component), Vc), fdim, facets)
-            dirichlet.append(dolfinx.fem.dirichletbc(g, dofs, V.sub(bc.component)))
-        else:
-            g = dolfinx.fem.Function(Q)
-            dofs = dolfinx.fem.locate_dofs_topological(Q, fdim, facets)
-            p_dirichlet.append(dolfinx.fem.dirichletbc(g, dofs))
-            dirichlet.append(p_dirichlet[-1])
-        updates.append((g, bc.value, ()))
-
-    # -- forms -------------------------------------------------------------------------------
-    lam_v = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
-    mu_v = E / (2.0 * (1.0 + nu))
-    lam = dolfinx.fem.Constant(mesh, scalar(lam_v))
-    mu = dolfinx.fem.Constant(mesh, scalar(mu_v))
-    k_c = dolfinx.fem.Constant(mesh, scalar(k))
-    alpha_c = dolfinx.fem.Constant(mesh, scalar(alpha))
-    S_c = dolfinx.fem.Constant(mesh, scalar(S))
-    dt_c = dolfinx.fem.Constant(mesh, scalar(times[1] - times[0]))
-
-    def eps(w):
-        return ufl.sym(ufl.grad(w))
-
-    def sigma(w):
-        return lam * ufl.tr(eps(w)) * ufl.Identity(2) + 2.0 * mu * eps(w)
-
-    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
-    p, q = ufl.TrialFunction(Q), ufl.TestFunction(Q)
-    dx = ufl.dx(domain=mesh)
-    uh = dolfinx.fem.Function(V, name="u")
-    ph = dolfinx.fem.Function(Q, name="p")
-    u_n = dolfinx.fem.Function(V)
-    p_n = dolfinx.fem.Function(Q)
-
-    fpp = element == "q1q1-fpp"
-    theta = dt_c if fpp_form == "seed" else dolfinx.fem.Constant(mesh, scalar(1.0))
-    if fpp:
-        DG0 = dolfinx.fem.functionspace(mesh, ("DG", 0))
-        eps_f = dolfinx.fem.Function(DG0, name="eps_f")
-
-    # Storage equation multiplied by -1 so that the system is symmetric (eq. 3.43). The p-p
-    # block is split into its dt-independent part (in A0, assembled once) and the part that
-    # changes with dt (K_H and FPP, assembled on Q only and added per distinct dt).
-    a_uu = ufl.inner(sigma(u), eps(v)) * dx
-    a_up = -alpha_c * p * ufl.div(v) * dx
-    a_pu = -alpha_c * q * ufl.div(u) * dx
-    a_pp0 = -S_c * p * q * dx
-    a_k = -k_c * ufl.inner(ufl.grad(p), ufl.grad(q)) * dx
-    a_pp = a_pp0 + dt_c * a_k  # the full p-p form, used for lifting Dirichlet data
-    L_p = -(alpha_c * q * ufl.div(u_n) + S_c * p_n * q) * dx
-    if fpp:  # the int eps_f psi p part of eq. 3.52; the projection part is added with PETSc
-        a_eps = -eps_f * p * q * dx
-        a_pp = a_pp + theta * a_eps
-        if fpp_form == "rate":
-            L_p = L_p - eps_f * p_n * q * dx
-
-    W = dolfinx.fem.functionspace(mesh, ("Lagrange", deg_u, (2,)))
-    L_u = ufl.inner(dolfinx.fem.Constant(mesh, np.zeros(2, dtype=scalar)), v) * dx
-    if tractions:
-        tags = _facet_tags(mesh, [b.boundary for b in tractions], "traction")
-        ds_t = ufl.Measure("ds", domain=mesh, subdomain_data=tags)
-        for i, bc in enumerate(tractions):
-            t_fn = dolfinx.fem.Function(W)
-            updates.append((t_fn, bc.value, (2,)))
-            L_u = L_u + ufl.inner(t_fn, v) * ds_t(i + 1)
-    if fluxes:
-        Qf = dolfinx.fem.functionspace(mesh, ("Lagrange", 2))
-        tags = _facet_tags(mesh, [b.boundary for b in fluxes], "flux")
-        ds_q = ufl.Measure("ds", domain=mesh, subdomain_data=tags)
-        for i, bc in enumerate(fluxes):
-            q_fn = dolfinx.fem.Function(Qf)
-            updates.append((q_fn, bc.value, ()))
-            L_p = L_p + dt_c * q_fn * q * ds_q(i + 1)
-
-    a_forms = dolfinx.fem.form([[a_uu, a_up], [a_pu, a_pp]])
-    L_forms = dolfinx.fem.form([L_u, L_p])
-    bcs0 = dolfinx.fem.bcs_by_block(dolfinx.fem.extract_function_spaces(L_forms), dirichlet)
-    bcs1 = dolfinx.fem.bcs_by_block(dolfinx.fem.extract_function_spaces(a_forms, 1), dirichlet)
-
-    # -- dt-independent part A0 (Dirichlet rows/columns replaced by the identity) -----------
-    t0 = time.perf_counter()
-    a0_forms = dolfinx.fem.form([[a_uu, a_up], [a_pu, a_pp0]])
-    A0 = dolfinx.fem.petsc.assemble_matrix(a0_forms, bcs=dirichlet, kind="nest")
-    A0.assemble()
-    A0.convert(PETSc.Mat.Type.AIJ)  # in place; rows [u owned, p owned] per rank, as create_vector
-    # K_H on Q with the pressure-Dirichlet rows/columns zeroed (diagonal 0: A0 holds the 1).
-    Kk = dolfinx.fem.petsc.assemble_matrix(dolfinx.fem.form(a_k), bcs=p_dirichlet, diag=0.0)
-    Kk.assemble()
-    # Injection of Q into the monolithic numbering: P[i, g(i)] = 1, so P^T X P embeds X.
-    n_u = V.dofmap.index_map.size_local * V.dofmap.index_map_bs
-    q_imap = Q.dofmap.index_map
-    n_q = q_imap.size_local
-    mono_start = A0.getOwnershipRange()[0]
-    inject = PETSc.Mat().createAIJ(
-        ((n_q, q_imap.size_global), A0.getSizes()[1]),
-        csr=(
-            np.arange(n_q + 1, dtype=PETSc.IntType),
-            (mono_start + n_u + np.arange(n_q)).astype(PETSc.IntType),
-            np.ones(n_q, dtype=PETSc.ScalarType),
-        ),
-        comm=comm,
-    )
-    t_matrix = time.perf_counter() - t0
-
-    # -- FPP projection part: R = C diag(eps_f / |K|) C^T with C the Q1 x DG0 mixed mass ------
-    if fpp:
-        mu0 = ufl.TestFunction(DG0)
-        Ct = dolfinx.fem.petsc.assemble_matrix(dolfinx.fem.form(p * mu0 * dx))  # (cells, Q dofs)
-        Ct.assemble()
-        area = dolfinx.fem.assemble_vector(dolfinx.fem.form(mu0 * dx))
-        area.scatter_reverse(dolfinx.la.InsertMode.add)
-        area.scatter_forward()
-        cell_area = area.array.copy()  # owned + ghost cells [m^2]
-        n_cells_owned = DG0.dofmap.index_map.size_local
-        p_bc_rows = np.unique(
-            np.concatenate(
-                [np.zeros(0, dtype=np.int64)]
-                + [
-                    q_imap.local_to_global(bc.dof_indices()[0][: bc.dof_indices()[1]].astype(np.int32))
-                    for bc in p_dirichlet
-                ]
-            )
-        ).astype(PETSc.IntType)
-        a_eps_form = dolfinx.fem.form(a_eps)
-
-    def fpp_matrices(dt: float):
-        """eps_f of this dt into the DG0 Function; returns (R, Meps - R with p-BC rows/cols zeroed).
-
-        ``Meps = int eps_f psi p`` enters with a minus sign (``a_eps``), so the second matrix is
-        ``-S_fpp`` of eq. 3.52 with Dirichlet rows/columns zeroed.
-        """
-        eps_f.x.array[:] = fpp_parameter(E, nu, k, alpha, S, dt, np.sqrt(cell_area))
-        d = Ct.createVecLeft()
-        d.array[:] = eps_f.x.array[:n_cells_owned] / cell_area[:n_cells_owned]
-        Cs = Ct.copy()
-        Cs.diagonalScale(L=d)
-        R = Ct.transposeMatMult(Cs)  # Ct^T diag(eps/|K|) Ct, Q x Q
-        Cs.destroy()
-        d.destroy()
-        minus_S = dolfinx.fem.petsc.assemble_matrix(a_eps_form, bcs=p_dirichlet, diag=0.0)
-        minus_S.assemble()
-        R0 = R.copy()
-        R0.zeroRowsColumns(p_bc_rows, diag=0.0)
-        minus_S.axpy(1.0, R0, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-        R0.destroy()
-        return R, minus_S
-
-    # -- matrix cache by dt ----------------------------------------------------------------
-    cache: OrderedDict[float, dict[str, Any]] = OrderedDict()
-    n_factorizations = 0
-
-    def system(dt: float) -> dict[str, Any]:
-        nonlocal n_factorizations, t_matrix
-        key = float(f"{dt:.12g}")
-        if key in cache:
-            cache.move_to_end(key)
-            return cache[key]
-        t0 = time.perf_counter()
-        entry: dict[str, Any] = {"dt": dt}
-        X = Kk.copy()
-        X.scale(dt)  # -dt K_H
-        if fpp:
-            R, minus_S = fpp_matrices(dt)
-            # eq. 3.51: -dt S ("seed"); White & Borja's rate form: -S on P_n+1 - P_n ("rate").
-            theta_v = dt if fpp_form == "seed" else 1.0
-            X.axpy(theta_v, minus_S, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-            minus_S.destroy()
-            entry["R"] = R
-        X_mono = X.PtAP(inject)
-        X.destroy()
-        A = A0.copy()
-        A.axpy(1.0, X_mono, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
-        X_mono.destroy()
-        prefix = f"rkfx_fem_biot_{next(_prefix_counter)}_"
-        opts = PETSc.Options()
-        for name, val in _MUMPS_OPTIONS.items():
-            opts[prefix + name] = val
-        A.setOptionsPrefix(prefix)
-        A.setFromOptions()
-        ksp = PETSc.KSP().create(comm)
-        ksp.setOptionsPrefix(prefix)
-        ksp.setOperators(A)
-        ksp.setFromOptions()
-        ksp.setUp()  # factorise now: MUMPS reads its options (ICNTL) at factorisation time
-        for name in _MUMPS_OPTIONS:
-            del opts[prefix + name]
-        entry["A"], entry["ksp"] = A, ksp
-        cache[key] = entry
-        n_factorizations += 1
-        while len(cache) > _CACHE_SIZE:
-            _, old = cache.popitem(last=False)
-            for obj in ("ksp", "A", "R"):
-                if obj in old:
-                    old[obj].destroy()
-        t_matrix += time.perf_counter() - t0
-        return entry
-
-    # -- initial state ---------------------------------------------------------------------
+    model = FemBiotModel(mesh, E, nu, k, alpha, S, element, bcs, fpp_form, t0=float(times[0]))
+    uh = dolfinx.fem.Function(model.V, name="u")
+    ph = dolfinx.fem.Function(model.Q, name="p")
     if initial_u is not None:
-        u_n.interpolate(lambda x: _values(lambda X, t: initial_u(X), x, times[0], (2,)))
+        uh.interpolate(lambda x: _values(lambda X, t: initial_u(X), x, times[0], (2,)))
     if initial_p is not None:
-        p_n.interpolate(lambda x: _values(lambda X, t: initial_p(X), x, times[0], ()))
-    uh.x.array[:] = u_n.x.array
-    ph.x.array[:] = p_n.x.array
+        ph.interpolate(lambda x: _values(lambda X, t: initial_p(X), x, times[0], ()))
+    n = model.layout.size
+    start = StepState(0, float(times[0]), model.vector(uh, ph), np.zeros(n), np.zeros(n),
+                      np.zeros(model.num_constraints))
+    kept = _Samples(model, _Sampler(mesh, sample_points), out_index, uh, ph)
+    kept.record(start)
+    t_setup, sampled = time.perf_counter() - t_start, kept.seconds
 
-    sampler = _Sampler(mesh, sample_points)
-    m = sampler.x3.shape[0]
-    out_p = np.full((len(output_times), m), np.nan)
-    out_u = np.full((len(output_times), m, 2), np.nan)
-    t_sample = 0.0
-
-    def record(n: int) -> None:
-        nonlocal t_sample
-        t0 = time.perf_counter()
-        for j in np.flatnonzero(out_index == n):
-            out_p[j], out_u[j] = sampler(uh, ph)
-        t_sample += time.perf_counter() - t0
-
-    record(0)
-    b = dolfinx.fem.petsc.create_vector([V, Q], kind="mpi")
-    x = dolfinx.fem.petsc.create_vector([V, Q], kind="mpi")
-    off0, _ = b.getAttr("_blocks")
-    if fpp and p_dirichlet:
-        g_vec = dolfinx.fem.petsc.create_vector(Q)  # p-BC values, zero elsewhere (for lifting R)
-        Rg = g_vec.duplicate()
-    if fpp and fpp_form == "rate":
-        Pn = dolfinx.fem.petsc.create_vector(Q)
-        RPn = Pn.duplicate()
-    t_setup = time.perf_counter() - t_start - t_matrix  # t_matrix so far: A0, Kk, injection
-    t_solve = 0.0
-
+    solves = Factorizations(comm, "mumps", keep=2, mumps_icntl=_MUMPS_ICNTL, reuse_analysis=True)
     try:
-        for n in range(1, len(times)):
-            dt = float(times[n] - times[n - 1])
-            t_new = float(times[n])
-            entry = system(dt)
-            t0 = time.perf_counter()
-            dt_c.value = entry["dt"]
-            for fn, data, shape in updates:
-                if callable(data) or n == 1:
-                    fn.interpolate(lambda X, data=data, shape=shape: _values(data, X, t_new, shape))
-            if fpp:  # eps_f of this dt (the RHS of the rate form uses it)
-                eps_f.x.array[:] = fpp_parameter(E, nu, k, alpha, S, entry["dt"], np.sqrt(cell_area))
-            with b.localForm() as b_loc:
-                b_loc.set(0.0)
-            dolfinx.fem.petsc.assemble_vector(b, L_forms)
-            dolfinx.fem.petsc.apply_lifting(b, a_forms, bcs=bcs1)
-            b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-            if fpp:
-                scale = entry["dt"] if fpp_form == "seed" else 1.0
-                b_p = b.array[off0[1] : off0[2]].copy()
-                if p_dirichlet:  # lifting of the projection part: b_p -= (theta R)[:, bc] g
-                    with g_vec.localForm() as g_loc:
-                        g_loc.set(0.0)
-                    for bc in p_dirichlet:
-                        bc.set(g_vec.array_w)
-                    entry["R"].mult(g_vec, Rg)
-                    b_p -= scale * Rg.array_r
-                if fpp_form == "rate":  # -(Meps - R) P_n: the Meps part is in L_p
-                    Pn.array[:] = p_n.x.array[: q_imap.size_local]
-                    entry["R"].mult(Pn, RPn)
-                    b_p += RPn.array_r
-                b.array[off0[1] : off0[2]] = b_p
-            dolfinx.fem.petsc.set_bc(b, bcs0)
-            ksp = entry["ksp"]
-            ksp.solve(b, x)
-            reason = ksp.getConvergedReason()
-            if reason < 0:
-                raise RuntimeError(
-                    f"Biot {element} solve failed at step {n} (t = {t_new:g}, dt = {dt:g}): "
-                    f"KSP reason {reason}"
-                )
-            x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
-            dolfinx.fem.petsc.assign(x, [uh, ph])
-            u_n.x.array[:] = uh.x.array
-            p_n.x.array[:] = ph.x.array
-            t_solve += time.perf_counter() - t0
-            record(n)
+        run = integrate(backward_euler(), model, times, start=start, recorder=kept, solves=solves, max_cuts=0,
+                        checkpoint_every=checkpoint_every, checkpoint_dir=checkpoint_dir, resume=resume)
     finally:
-        for entry in cache.values():
-            for obj in ("ksp", "A", "R"):
-                if obj in entry:
-                    entry[obj].destroy()
-        cache.clear()
-        for obj in (b, x, A0, Kk, inject):
-            obj.destroy()
-        if fpp:
-            Ct.destroy()
-            if p_dirichlet:
-                g_vec.destroy()
-                Rg.destroy()
-            if fpp_form == "rate":
-                Pn.destroy()
-                RPn.destroy()
+        solves.destroy()
+    model.assign(run.state.x, uh, ph)
 
-    local = np.array([t_setup, t_matrix, t_solve, t_sample, time.perf_counter() - t_start])
+    t_sample = kept.seconds - sampled
+    local = np.array([t_setup, run.wall_time_s - t_sample, t_sample, time.perf_counter() - t_start])
     glob = np.empty_like(local)
     comm.Allreduce(local, glob, op=MPI.MAX)
-    n_dofs = int(V.dofmap.index_map.size_global * V.dofmap.index_map_bs + q_imap.size_global)
     return BiotResult(
         output_times=output_times.copy(),
-        p=out_p,
-        u=out_u,
-        n_dofs=n_dofs,
-        wall_time_s=float(glob[4]),
+        p=kept.p,
+        u=kept.u,
+        n_dofs=n,
+        wall_time_s=float(glob[3]),
         mesh=mesh,
         u_h=uh,
         p_h=ph,
         element=element,
         n_steps=len(times) - 1,
-        n_factorizations=n_factorizations,
-        timings=dict(zip(("setup", "matrix", "solve", "sample"), map(float, glob[:4]))),
+        n_factorizations=run.factorizations,
+        timings=dict(zip(("setup", "steps", "sample"), map(float, glob[:3]))),
     )

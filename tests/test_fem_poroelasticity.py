@@ -179,6 +179,41 @@ def test_uniform_pressure_state_is_preserved(element, form):
     assert np.abs(res.u).max() < 1e-10
 
 
+class _Stop(Exception):
+    """Stands for a run killed mid-way."""
+
+
+@pytest.mark.parametrize("element,form", [("taylor-hood", "rate"), ("q1q1-fpp", "seed")])
+def test_resumed_run_equals_an_uninterrupted_one(tmp_path, element, form):
+    """A run stopped in step 8 resumes from its checkpoint of step 6 (every 3 steps) and ends
+    as a run that was never stopped: samples before and after the checkpoint, final fields.
+    The seed form's step size depends on the committed time, which the checkpoint keeps."""
+    times = np.r_[0.0, np.cumsum(1e3 * 1.3 ** np.arange(12))]  # c dt / h^2 from 0.016: FPP active
+    out = times[[1, 6, 12]]
+
+    def bcs(stop_after=np.inf):
+        def load(x, t):
+            if t > stop_after:
+                raise _Stop
+            return np.vstack([0 * x[0], np.full(x.shape[1], -T_Q * min(1.0, t / times[3]))])
+
+        return terzaghi_bcs()[:4] + [pe.Traction("top", load), pe.Pressure("top", 0.0)]
+
+    cell = "triangle" if element == "taylor-hood" else "quadrilateral"
+    mesh = pe.rectangle_mesh(T_XS, T_YS, cell)
+    args = (mesh, T_E, T_NU, T_K, T_ALPHA, 0.0, element)
+    whole = pe.solve_biot(*args, bcs(), times, T_POINTS, out, fpp_form=form)
+    with pytest.raises(_Stop):
+        pe.solve_biot(*args, bcs(stop_after=times[7]), times, T_POINTS, out, fpp_form=form, checkpoint_every=3,
+                      checkpoint_dir=tmp_path)
+    resumed = pe.solve_biot(*args, bcs(), times, T_POINTS, out, fpp_form=form, resume=tmp_path)
+    scale = np.abs(whole.p).max()
+    assert np.abs(resumed.p - whole.p).max() <= 1e-12 * scale  # measured: identical
+    assert np.abs(resumed.u - whole.u).max() <= 1e-12 * np.abs(whole.u).max()
+    assert np.abs(resumed.p_h.x.array - whole.p_h.x.array).max() <= 1e-12 * scale
+    assert resumed.n_factorizations < whole.n_factorizations  # steps 7-12 only
+
+
 # --------------------------------------------------------------------------- Mandel
 # The seed's quarter domain (sec. 3.4.2, Preisig & Prevost parameters): Lx = 20, Ly = 2,
 # 101 x 11 nodes (h = 0.2), E = 1e4, nu = 0, nu_u = 0.5, k = 1e-4, alpha = 1, S = 0, F = 2 Lx
