@@ -1,6 +1,7 @@
 """Checkpoint files: named arrays written atomically, so an interrupted run never leaves a
 half-written checkpoint (temporary file, fsync, then ``os.replace``)."""
 import os
+import sys
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -11,9 +12,21 @@ from ..errors import InputError
 CHECKPOINT = "checkpoint.npz"
 
 
-def save_arrays(directory: str | Path, arrays: Mapping[str, np.ndarray], name: str = CHECKPOINT) -> Path:
-    """Write ``DIR/name`` atomically; returns its path."""
+def writes(comm) -> bool:
+    """Whether this rank writes the files of a replicated state: rank 0 of ``comm``, or of
+    MPI's world when no communicator is given and MPI is in use (this module never imports it)."""
+    if comm is None:
+        mpi = sys.modules.get("mpi4py.MPI")
+        comm = mpi.COMM_WORLD if mpi is not None else None
+    return comm is None or comm.rank == 0
+
+
+def save_arrays(directory: str | Path, arrays: Mapping[str, np.ndarray], name: str = CHECKPOINT,
+                comm=None) -> Path:
+    """Write ``DIR/name`` atomically (on one rank of ``comm``, see ``writes``); returns its path."""
     directory = Path(directory)
+    if not writes(comm):
+        return directory / name
     directory.mkdir(parents=True, exist_ok=True)
     target = directory / name
     tmp = directory / (name + ".tmp")

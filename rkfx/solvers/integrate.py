@@ -179,7 +179,7 @@ def integrate(stepper: Newmark, model: Model, times: Sequence[float], *, start: 
                 arrays = prefixed(s.arrays(), "state__") | prefixed(model.state(), "model__")
                 if recorder is not None:
                     arrays |= prefixed(recorder.arrays(), "kept__")
-                save_arrays(checkpoint_dir, arrays)
+                save_arrays(checkpoint_dir, arrays, comm=comm)
     finally:
         made = solves.count - made
         if own:

@@ -320,7 +320,7 @@ def march(model: Model, targets, stepper: QuasiStatic = QuasiStatic(), *, record
             | prefixed(model.state(), "model__")
         if recorder is not None:
             arrays |= prefixed(recorder.arrays(), "kept__")
-        save_arrays(checkpoint_dir, arrays)
+        save_arrays(checkpoint_dir, arrays, comm=comm)
 
     def solve(mode, lam_start, **control):
         """Newton from the committed state; the converged (x, mu, lam) or the failed result."""
