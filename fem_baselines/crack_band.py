@@ -20,7 +20,7 @@ element column never snaps back when w_c > f_t L / E), each solved by Newton's
 method with the consistent tangent (1 - D) C - D' (C eps) (x) d eps_eq / d eps (non-symmetric;
 MUMPS LU through PETSc), following dolfinx's Newton convention for the Dirichlet data
 (lifting with x0 = u, alpha = -1). The strain, stress and tangent live in DG0 spaces; the
-material update is the vectorised numpy code of ``rkfx.damage``. The tip force is the virtual
+material update is ``rkfx.damage.update``, the law of the particles. The tip force is the virtual
 work of the stresses on v = (x / L, 0): F = t sum_e sigma_xx,e V_e / L.
 
 Runs on one process (``MPI.COMM_SELF``): the bar has a few hundred unknowns.

@@ -6,7 +6,8 @@ stress positive, pore pressure compressive positive, no gravity):
     div(sigma''(u) - alpha p I) = 0,
     alpha div(du/dt) + S dp/dt - div(k grad p) = 0,
 
-with the drained plane-strain law ``sigma'' = lambda tr(eps) I + 2 mu eps`` (E, nu drained),
+with the drained plane-strain law ``sigma'' = lambda tr(eps) I + 2 mu eps`` (E, nu drained;
+``fem_baselines.elasticity.stress_law`` of ``rkfx.elasticity.ElasticMaterial``),
 Biot coefficient ``alpha``, storage coefficient ``S = 1/Q`` [1/Pa] (0 = incompressible
 constituents) and mobility ``k`` [m^2/(Pa s)] (permeability / viscosity, i.e. ``k_h/gamma_f``).
 
@@ -19,7 +20,8 @@ monolithically at every step (eqs. 3.38-3.44):
 where ``S`` (only for ``element="q1q1-fpp"``) is the fluid-pressure-projection stabilisation of
 White & Borja (2008) as the seed writes it in eqs. 3.49-3.52,
 ``S = int eps_f (psi - Pi psi)(p - Pi p)`` with ``Pi`` the cell-wise L2 projection onto constants
-and ``eps_f`` from eqs. 3.53-3.54 (``h = sqrt(cell area)``). It is assembled exactly as
+and ``eps_f`` from eqs. 3.53-3.54 (``rkfx.poroelasticity.fpp_parameter``, ``h = sqrt(cell
+area)``). It is assembled exactly as
 ``S = M_eps - C diag(eps_f / |K|) C^T`` (``M_eps`` the eps_f-weighted Q1 mass matrix, ``C`` the
 Q1 x DG0 mixed mass matrix), the second term by PETSc sparse products.
 
@@ -69,13 +71,16 @@ import dolfinx.la
 import dolfinx.mesh
 import ufl
 
+from fem_baselines.elasticity import strain, stress_law
+from rkfx.elasticity import ElasticMaterial
+from rkfx.poroelasticity import PoroMaterial, fpp_parameter
+
 __all__ = [
     "BiotResult",
     "Displacement",
     "Flux",
     "Pressure",
     "Traction",
-    "fpp_parameter",
     "rectangle_mesh",
     "solve_biot",
 ]
@@ -260,33 +265,6 @@ def rectangle_mesh(
 
 
 # --------------------------------------------------------------------------- helpers
-
-
-def fpp_parameter(
-    E: float, nu: float, k: float, alpha: float, S: float, dt: float, h: np.ndarray
-) -> np.ndarray:
-    """FPP stabilisation parameter eps_f of eqs. (3.53)-(3.54) (after Sun et al. 2013).
-
-    ``eps_f = (1/M') <1 - 3 c dt/h^2> (1 + tanh(2 - 12 c dt/h^2))`` with
-    ``M' = K_v / (K_v S + alpha^2)``, ``K_v = K + 4G/3`` (constrained modulus) and ``c = k M'``.
-
-    Args:
-        E: Drained Young's modulus [Pa].
-        nu: Drained Poisson's ratio [-].
-        k: Mobility [m^2/(Pa s)].
-        alpha: Biot coefficient [-].
-        S: Storage coefficient 1/Q [1/Pa].
-        dt: Time step [s].
-        h: Characteristic cell sizes, any shape [m].
-
-    Returns:
-        eps_f, same shape as ``h`` [1/Pa].
-    """
-    Kv = E * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))
-    inv_M = (Kv * S + alpha**2) / Kv  # 1/M', written without dividing by S (S = 0 allowed)
-    c = k / inv_M
-    r = c * dt / np.asarray(h, dtype=np.float64) ** 2
-    return inv_M * np.maximum(1.0 - 3.0 * r, 0.0) * (1.0 + np.tanh(2.0 - 12.0 * r))
 
 
 def _values(data: Any, x: np.ndarray, t: float, shape: tuple[int, ...]) -> np.ndarray:
@@ -491,20 +469,11 @@ def solve_biot(
         updates.append((g, bc.value, ()))
 
     # -- forms -------------------------------------------------------------------------------
-    lam_v = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
-    mu_v = E / (2.0 * (1.0 + nu))
-    lam = dolfinx.fem.Constant(mesh, scalar(lam_v))
-    mu = dolfinx.fem.Constant(mesh, scalar(mu_v))
+    sigma = stress_law(mesh, ElasticMaterial(E, nu))
     k_c = dolfinx.fem.Constant(mesh, scalar(k))
     alpha_c = dolfinx.fem.Constant(mesh, scalar(alpha))
     S_c = dolfinx.fem.Constant(mesh, scalar(S))
     dt_c = dolfinx.fem.Constant(mesh, scalar(times[1] - times[0]))
-
-    def eps(w):
-        return ufl.sym(ufl.grad(w))
-
-    def sigma(w):
-        return lam * ufl.tr(eps(w)) * ufl.Identity(2) + 2.0 * mu * eps(w)
 
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
     p, q = ufl.TrialFunction(Q), ufl.TestFunction(Q)
@@ -519,11 +488,12 @@ def solve_biot(
     if fpp:
         DG0 = dolfinx.fem.functionspace(mesh, ("DG", 0))
         eps_f = dolfinx.fem.Function(DG0, name="eps_f")
+        poro = PoroMaterial(E, nu, k, alpha, S)  # eps_f of eq. 3.53
 
     # Storage equation multiplied by -1 so that the system is symmetric (eq. 3.43). The p-p
     # block is split into its dt-independent part (in A0, assembled once) and the part that
     # changes with dt (K_H and FPP, assembled on Q only and added per distinct dt).
-    a_uu = ufl.inner(sigma(u), eps(v)) * dx
+    a_uu = ufl.inner(sigma(u), strain(v)) * dx
     a_up = -alpha_c * p * ufl.div(v) * dx
     a_pu = -alpha_c * q * ufl.div(u) * dx
     a_pp0 = -S_c * p * q * dx
@@ -611,7 +581,7 @@ def solve_biot(
         ``Meps = int eps_f psi p`` enters with a minus sign (``a_eps``), so the second matrix is
         ``-S_fpp`` of eq. 3.52 with Dirichlet rows/columns zeroed.
         """
-        eps_f.x.array[:] = fpp_parameter(E, nu, k, alpha, S, dt, np.sqrt(cell_area))
+        eps_f.x.array[:] = fpp_parameter(poro, dt, np.sqrt(cell_area))
         d = Ct.createVecLeft()
         d.array[:] = eps_f.x.array[:n_cells_owned] / cell_area[:n_cells_owned]
         Cs = Ct.copy()
@@ -722,7 +692,7 @@ def solve_biot(
                 if callable(data) or n == 1:
                     fn.interpolate(lambda X, data=data, shape=shape: _values(data, X, t_new, shape))
             if fpp:  # eps_f of this dt (the RHS of the rate form uses it)
-                eps_f.x.array[:] = fpp_parameter(E, nu, k, alpha, S, entry["dt"], np.sqrt(cell_area))
+                eps_f.x.array[:] = fpp_parameter(poro, entry["dt"], np.sqrt(cell_area))
             with b.localForm() as b_loc:
                 b_loc.set(0.0)
             dolfinx.fem.petsc.assemble_vector(b, L_forms)
