@@ -21,6 +21,9 @@ import dolfinx.fem.petsc
 import dolfinx.mesh
 import ufl
 
+from fem_baselines.elasticity import strain, stress_law
+from rkfx.elasticity import ElasticMaterial
+
 __all__ = ["time_p1_assembly"]
 
 
@@ -30,17 +33,9 @@ def _stiffness_form(mesh: dolfinx.mesh.Mesh) -> ufl.Form:
     E and nu enter as Constants so every mesh shares one compiled kernel.
     """
     V = dolfinx.fem.functionspace(mesh, ("Lagrange", 1, (2,)))
-    E, nu = 1.0, 0.3
-    scalar = dolfinx.default_scalar_type
-    lam = dolfinx.fem.Constant(mesh, scalar(E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))))
-    mu = dolfinx.fem.Constant(mesh, scalar(E / (2.0 * (1.0 + nu))))
+    sigma = stress_law(mesh, ElasticMaterial(1.0, 0.3))
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
-
-    def eps(w):
-        return ufl.sym(ufl.grad(w))
-
-    sigma = lam * ufl.tr(eps(u)) * ufl.Identity(2) + 2.0 * mu * eps(u)
-    return ufl.inner(sigma, eps(v)) * ufl.dx
+    return ufl.inner(sigma(u), strain(v)) * ufl.dx
 
 
 def _assemble(a_compiled) -> tuple[PETSc.Mat, float, float]:

@@ -22,7 +22,7 @@ consistent tangent (1 - D) C - D' (C eps) (x) d eps_eq / d eps (non-symmetric; M
 ``rkfx.linear_solver``). dolfinx assembles the residual and tangent; the Dirichlet conditions are
 unit rows of their dofs imposed with multipliers, whose sum over the right-end u_x dofs (times
 the thickness) is the tip force. The strain, stress and tangent live in DG0 spaces; the
-material update is the vectorised numpy code of ``rkfx.damage``.
+material update is ``rkfx.damage.update``, the law of the particles.
 
 The mesh lives on one process (``MPI.COMM_SELF``): the bar has a few hundred unknowns; the
 linear solves take a communicator.

@@ -78,7 +78,8 @@ import ufl
 
 from rkfx import damage as dm
 from rkfx.errors import InputError
-from rkfx.explicit import Constraint
+from rkfx.elasticity import ElasticMaterial
+from rkfx.explicit import Constraint, dilatational_wave_speed
 from rkfx.explicit_damage import DamageRun, run_damage, run_key
 from rkfx.ranks import on_root
 
@@ -320,9 +321,7 @@ def stable_time_step(m: CrackedPlateMesh, E: float, nu: float, rho: float, coura
     """dt = courant * (smallest altitude of any cell) / c_d [s], c_d = sqrt((lambda + 2 mu) / rho)."""
     if not 0 < courant <= 1:
         raise InputError(f"courant = {courant!r} must lie in (0, 1]; 0.5 is the default")
-    lam = E * nu / ((1 + nu) * (1 - 2 * nu))
-    mu = E / (2 * (1 + nu))
-    c_d = np.sqrt((lam + 2 * mu) / rho)
+    c_d = dilatational_wave_speed(ElasticMaterial(E, nu), rho)
     return float(courant * _altitudes(m.vertices).min() / c_d)
 
 

@@ -11,8 +11,8 @@ rank 0, distributed over ``comm``), then the problem
 
 is solved with vector Lagrange P``degree`` elements on triangles and a direct
 MUMPS LU factorisation, with the plane-strain constitutive law
-``sigma = lambda tr(eps) I + 2 mu eps``,
-``lambda = E nu / ((1 + nu)(1 - 2 nu))``, ``mu = E / (2 (1 + nu))``.
+``sigma = lambda tr(eps) I + 2 mu eps``, lambda and mu from
+:class:`rkfx.elasticity.ElasticMaterial` (the law of the RKPM solvers).
 
 Units are whatever the caller uses consistently (e.g. m, Pa, N/m^3); the
 module never rescales anything.
@@ -43,11 +43,14 @@ import dolfinx.io.gmsh
 import dolfinx.mesh
 import ufl
 
+from rkfx.elasticity import ElasticMaterial
+
 __all__ = [
     "FemElasticityResult",
     "errors",
-    "lame_plane_strain",
     "solve_plane_strain",
+    "strain",
+    "stress_law",
 ]
 
 #: A boundary is named by a physical-group name (str), a facet-tag value
@@ -71,19 +74,31 @@ _MUMPS_OPTIONS = {
 }
 
 
-def lame_plane_strain(E: float, nu: float) -> tuple[float, float]:
-    """Lamé parameters of the plane-strain law.
+def strain(w):
+    """Small strain eps(w) = sym(grad w) of a UFL vector field."""
+    return ufl.sym(ufl.grad(w))
 
-    Args:
-        E: Young's modulus (stress units, e.g. Pa).
-        nu: Poisson's ratio (dimensionless, -1 < nu < 0.5).
+
+def stress_law(mesh: dolfinx.mesh.Mesh, material: ElasticMaterial) -> Callable:
+    """The 2-D law ``sigma(w) = lambda tr(eps(w)) I + 2 mu eps(w)`` of ``material`` in UFL.
+
+    lambda and mu are :attr:`rkfx.elasticity.ElasticMaterial.lame` (plane strain or plane
+    stress), as dolfinx Constants on ``mesh``: forms built with other values share one
+    compiled kernel.
 
     Returns:
-        ``(lam, mu)`` in the units of ``E``.
+        ``sigma(w)``: the stress tensor (2 x 2 UFL expression) of a vector field ``w`` [Pa].
     """
-    lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
-    mu = E / (2.0 * (1.0 + nu))
-    return lam, mu
+    scalar = dolfinx.default_scalar_type
+    lam_v, mu_v = material.lame
+    lam = dolfinx.fem.Constant(mesh, scalar(lam_v))
+    mu = dolfinx.fem.Constant(mesh, scalar(mu_v))
+
+    def sigma(w):
+        eps = strain(w)
+        return lam * ufl.tr(eps) * ufl.Identity(2) + 2.0 * mu * eps
+
+    return sigma
 
 
 @dataclass
@@ -343,19 +358,11 @@ def solve_plane_strain(
             bcs.append(dolfinx.fem.dirichletbc(gv, dofs))
 
     # Constitutive law (Constants: no recompilation for new E, nu).
-    lam_v, mu_v = lame_plane_strain(E, nu)
-    lam = dolfinx.fem.Constant(mesh, scalar(lam_v))
-    mu = dolfinx.fem.Constant(mesh, scalar(mu_v))
-
-    def eps(w):
-        return ufl.sym(ufl.grad(w))
-
-    def sigma(w):
-        return lam * ufl.tr(eps(w)) * ufl.Identity(2) + 2.0 * mu * eps(w)
+    sigma = stress_law(mesh, ElasticMaterial(E, nu))
 
     u = ufl.TrialFunction(V)
     v = ufl.TestFunction(V)
-    a = ufl.inner(sigma(u), eps(v)) * ufl.dx
+    a = ufl.inner(sigma(u), strain(v)) * ufl.dx
 
     rhs = []
     if body_force is not None:

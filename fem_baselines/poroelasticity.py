@@ -6,7 +6,8 @@ stress positive, pore pressure compressive positive, no gravity):
     div(sigma''(u) - alpha p I) = 0,
     alpha div(du/dt) + S dp/dt - div(k grad p) = 0,
 
-with the drained plane-strain law ``sigma'' = lambda tr(eps) I + 2 mu eps`` (E, nu drained),
+with the drained plane-strain law ``sigma'' = lambda tr(eps) I + 2 mu eps`` (E, nu drained;
+``fem_baselines.elasticity.stress_law`` of ``rkfx.elasticity.ElasticMaterial``),
 Biot coefficient ``alpha``, storage coefficient ``S = 1/Q`` [1/Pa] (0 = incompressible
 constituents) and mobility ``k`` [m^2/(Pa s)] (permeability / viscosity, i.e. ``k_h/gamma_f``).
 
@@ -19,7 +20,8 @@ monolithically at every step (eqs. 3.38-3.44):
 where ``S`` (only for ``element="q1q1-fpp"``) is the fluid-pressure-projection stabilisation of
 White & Borja (2008) as the seed writes it in eqs. 3.49-3.52,
 ``S = int eps_f (psi - Pi psi)(p - Pi p)`` with ``Pi`` the cell-wise L2 projection onto constants
-and ``eps_f`` from eqs. 3.53-3.54 (``h = sqrt(cell area)``). It is assembled exactly as
+and ``eps_f`` from eqs. 3.53-3.54 (``rkfx.poroelasticity.fpp_parameter``, ``h = sqrt(cell
+area)``). It is assembled exactly as
 ``S = M_eps - C diag(eps_f / |K|) C^T`` (``M_eps`` the eps_f-weighted Q1 mass matrix, ``C`` the
 Q1 x DG0 mixed mass matrix).
 
@@ -71,7 +73,10 @@ import dolfinx.la
 import dolfinx.mesh
 import ufl
 
+from fem_baselines.elasticity import strain, stress_law
+from rkfx.elasticity import ElasticMaterial
 from rkfx.linear_solver import Factorizations
+from rkfx.poroelasticity import PoroMaterial, fpp_parameter
 from rkfx.solvers.fields import Field, FieldLayout
 from rkfx.solvers.integrate import integrate
 from rkfx.solvers.model import Constraints
@@ -84,7 +89,6 @@ __all__ = [
     "Flux",
     "Pressure",
     "Traction",
-    "fpp_parameter",
     "rectangle_mesh",
     "solve_biot",
 ]
@@ -257,33 +261,6 @@ def rectangle_mesh(
 
 
 # --------------------------------------------------------------------------- helpers
-
-
-def fpp_parameter(
-    E: float, nu: float, k: float, alpha: float, S: float, dt: float, h: np.ndarray
-) -> np.ndarray:
-    """FPP stabilisation parameter eps_f of eqs. (3.53)-(3.54) (after Sun et al. 2013).
-
-    ``eps_f = (1/M') <1 - 3 c dt/h^2> (1 + tanh(2 - 12 c dt/h^2))`` with
-    ``M' = K_v / (K_v S + alpha^2)``, ``K_v = K + 4G/3`` (constrained modulus) and ``c = k M'``.
-
-    Args:
-        E: Drained Young's modulus [Pa].
-        nu: Drained Poisson's ratio [-].
-        k: Mobility [m^2/(Pa s)].
-        alpha: Biot coefficient [-].
-        S: Storage coefficient 1/Q [1/Pa].
-        dt: Time step [s].
-        h: Characteristic cell sizes, any shape [m].
-
-    Returns:
-        eps_f, same shape as ``h`` [1/Pa].
-    """
-    Kv = E * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))
-    inv_M = (Kv * S + alpha**2) / Kv  # 1/M', written without dividing by S (S = 0 allowed)
-    c = k / inv_M
-    r = c * dt / np.asarray(h, dtype=np.float64) ** 2
-    return inv_M * np.maximum(1.0 - 3.0 * r, 0.0) * (1.0 + np.tanh(2.0 - 12.0 * r))
 
 
 def _values(data: Any, x: np.ndarray, t: float, shape: tuple[int, ...]) -> np.ndarray:
@@ -464,15 +441,11 @@ class FemBiotModel:
         def constant(value):  # a Constant, not a literal: one compiled form for all parameters
             return dolfinx.fem.Constant(mesh, dolfinx.default_scalar_type(value))
 
-        def eps(w):
-            return ufl.sym(ufl.grad(w))
-
-        lam, mu = constant(E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))), constant(E / (2.0 * (1.0 + nu)))
+        sigma = stress_law(mesh, ElasticMaterial(E, nu))
         u, v = ufl.TrialFunction(self.V), ufl.TestFunction(self.V)
         p, q = ufl.TrialFunction(self.Q), ufl.TestFunction(self.Q)
         dx = ufl.dx(domain=mesh)
-        sigma = lam * ufl.tr(eps(u)) * ufl.Identity(2) + 2.0 * mu * eps(u)
-        kuu = _global_matrix(dolfinx.fem.form(ufl.inner(sigma, eps(v)) * dx), comm)
+        kuu = _global_matrix(dolfinx.fem.form(ufl.inner(sigma(u), strain(v)) * dx), comm)
         kup = _global_matrix(dolfinx.fem.form(constant(alpha) * p * ufl.div(v) * dx), comm)
         kh = _global_matrix(dolfinx.fem.form(constant(k) * ufl.inner(ufl.grad(p), ufl.grad(q)) * dx), comm)
         n_p = kh.shape[0]
@@ -605,9 +578,9 @@ class FemBiotModel:
     def stabilization(self, dt: float) -> sp.csr_matrix:
         """The FPP matrix S = M_eps - C diag(eps_f / |K|) C^T for steps of dt, shape ``(n_p, n_p)``."""
         def build(dt):
-            E, nu, k, alpha, S = self.material
-            self._eps_f.x.array[:] = fpp_parameter(E, nu, k, alpha, S, dt, np.sqrt(self._cell_area))
-            eps = fpp_parameter(E, nu, k, alpha, S, dt, np.sqrt(self._cell_area_global))
+            poro = PoroMaterial(*self.material)  # eps_f of eq. 3.53
+            self._eps_f.x.array[:] = fpp_parameter(poro, dt, np.sqrt(self._cell_area))
+            eps = fpp_parameter(poro, dt, np.sqrt(self._cell_area_global))
             projection = self._ct.T @ sp.diags(eps / self._cell_area_global) @ self._ct
             return (_global_matrix(self._m_eps, self.comm) - projection).tocsr()
 

@@ -10,10 +10,11 @@ The numerical core (this package's top-level modules) needs only numpy, scipy an
     quadrature       Gauss, DNI, SCNI and MSCNI rules as sparse rows (eqs. 3.55-3.56)
     operators        B^T D B w products: stiffness, diffusion, mass, loads
     boundary         boundary integration and essential conditions
-    elasticity       material laws
+    elasticity       the 2-D elastic law (plane strain or stress), principal directions
     elastostatics    plane-strain solver
     poroelasticity   equal-order u-p Biot solver: NI/SCNI with pressure projection (chapter 3)
     damage           damage particle method: Mazars strain, damage law, energy regularization (ch. 4)
+    damage_law       Mazars' strain and the softening law compiled, shared by statics and dynamics
     cracks           pre-existing cracks: diffraction of the kernel supports round crack tips
     explicit         central-difference dynamics with lumped mass, constraints, checkpoints
     crack_tracking   candidate damage particles along crack segments (eq. 4.22)

@@ -119,11 +119,3 @@ def tracking(x: np.ndarray, spacing: np.ndarray, tol: float, seeds: np.ndarray |
     new_ptr = np.zeros(n + 1, np.int64)
     np.cumsum(np.add.reduceat(keep.astype(np.int64), ptr[:-1]) if n else [], out=new_ptr[1:])
     return Tracking(x, new_ptr, idx[keep].astype(np.int64), float(tol), mask, bool(enabled), bool(forward))
-
-
-def principal_direction(stress: np.ndarray) -> np.ndarray:
-    """Unit direction of the maximum principal stress, shape ``(m, 2)``, from Voigt stress
-    (sigma_xx, sigma_yy, sigma_xy) of shape ``(m, 3)``."""
-    sxx, syy, sxy = stress[:, 0], stress[:, 1], stress[:, 2]
-    theta = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)
-    return np.column_stack([np.cos(theta), np.sin(theta)])

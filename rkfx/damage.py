@@ -3,18 +3,20 @@
 Each damage point (an SCNI particle, or any integration point) carries the scalar damage of
 the continuum damage model (4.1) driven by its *smeared* strain: for SCNI particles that is
 the cell-smoothed strain of eq. (4.21), ``strain_matrix(smoothed_gradients(...).cell) @ d``.
-Everything here is vectorised over the points (numpy; the per-point work is a few flops, so
-a compiled loop would not pay).
+Everything here is vectorised over the points. The law at a point, Mazars' strain and D, is
+compiled once in ``rkfx.damage_law``: ``update`` runs the point updates of the explicit force
+of ``rkfx.explicit_damage`` (serially), and ``equivalent_strain`` and ``damage`` are array
+forms of the same functions.
 
 * Mazars' equivalent strain (4.6) from the principal strains of Voigt strains
-  (eps_xx, eps_yy, gamma_xy).
+  (eps_xx, eps_yy, gamma_xy), and its gradient for the consistent tangent.
 * The linear-softening damage law (4.2) with the irreversible history variable
   kappa = max(kappa_old, eps_eq) (Kuhn-Tucker conditions 4.3-4.5).
 * The dissipation-energy regularization (4.26)-(4.28): kappa_c = (G_F / f_t) A_L / V_L, with
   A_L the chord of the particle's nodal domain through x_L along the crack (perpendicular to
   the crack normal n_L, which is fixed at damage initiation along the major principal
-  direction of the effective stress). ``chord_lengths`` computes it exactly for the
-  median-dual cells of ``rkfx.nodal_domains``.
+  direction of the effective stress, ``initiate``). ``chord_lengths`` computes it exactly for
+  the median-dual cells of ``rkfx.nodal_domains``.
 * The smeared stress (4.20)/(4.30), sigma = (1 - D) C eps, its consistent tangent, and the
   dissipated energy.
 * What the damage solvers share (``rkfx.cases.cracked_bar``, ``fem_baselines.crack_band``):
@@ -42,11 +44,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import damage_law as law
+from .elasticity import ElasticMaterial, out_of_plane_ratio, principal_direction
 from .errors import InputError
 from .nodal_domains import NodalDomains
 from .particles import Particles
-
-PLANES = ("strain", "stress")
 
 
 @dataclass(frozen=True)
@@ -58,7 +60,8 @@ class DamageMaterial:
         nu: Poisson's ratio [-].
         ft: Tensile strength f_t [Pa]; the damage threshold is kappa0 = f_t / E.
         GF: Fracture energy G_F [J/m^2 = N/m].
-        plane: ``"strain"`` or ``"stress"``: the 2-D idealization of C and of eps_zz in (4.6).
+        plane: ``"strain"`` or ``"stress"``: the 2-D idealization of C and of eps_zz in (4.6)
+            (``rkfx.elasticity.ElasticMaterial``).
     """
 
     E: float
@@ -73,10 +76,7 @@ class DamageMaterial:
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise InputError(f"{name} = {v!r} must be positive and finite ({fix})")
-        if not (-1.0 < self.nu < 0.5):
-            raise InputError(f"Poisson's ratio nu = {self.nu!r} must lie in (-1, 0.5)")
-        if self.plane not in PLANES:
-            raise InputError(f"plane = {self.plane!r}: choose 'strain' or 'stress'")
+        ElasticMaterial(self.E, self.nu, self.plane)  # validates nu and plane
         if not self.ft / self.E < 1.0:
             raise InputError(f"ft / E = {self.ft / self.E:g} is not a small strain; check the units of ft and E")
 
@@ -90,15 +90,14 @@ class DamageMaterial:
         """Critical crack opening w_c = 2 G_F / f_t of the linear cohesive law (4.7) [m]."""
         return 2.0 * self.GF / self.ft
 
+    @property
+    def elastic(self) -> ElasticMaterial:
+        """The undamaged solid (E, nu, plane)."""
+        return ElasticMaterial(self.E, self.nu, self.plane)
+
     def elasticity(self) -> np.ndarray:
         """Elastic matrix C in Voigt form (eps_xx, eps_yy, gamma_xy), shape ``(3, 3)`` [Pa]."""
-        E, nu = self.E, self.nu
-        if self.plane == "stress":
-            c = E / (1.0 - nu * nu)
-            return c * np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, 0.5 * (1.0 - nu)]])
-        lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
-        mu = E / (2.0 * (1.0 + nu))
-        return np.array([[lam + 2 * mu, lam, 0.0], [lam, lam + 2 * mu, 0.0], [0.0, 0.0, mu]])
+        return self.elastic.D()
 
 
 # --------------------------------------------------------------------------- strain measures
@@ -114,17 +113,10 @@ def principal_strains(strain: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         ``(values, direction)``: principal strains (major first), shape ``(m, 2)``, and the
         unit major principal direction, shape ``(m, 2)``.
     """
-    e = np.asarray(strain, float).reshape(-1, 3)
-    mean = 0.5 * (e[:, 0] + e[:, 1])
-    radius = np.hypot(0.5 * (e[:, 0] - e[:, 1]), 0.5 * e[:, 2])
-    theta = 0.5 * np.arctan2(e[:, 2], e[:, 0] - e[:, 1])
-    return np.column_stack([mean + radius, mean - radius]), np.column_stack([np.cos(theta), np.sin(theta)])
-
-
-def _out_of_plane(e: np.ndarray, nu: float, plane: str) -> np.ndarray:
-    if plane == "stress":
-        return -nu / (1.0 - nu) * (e[:, 0] + e[:, 1])
-    return np.zeros(len(e))
+    e = np.ascontiguousarray(strain, float).reshape(-1, 3)
+    values = np.empty((len(e), 2))
+    law.principal_strains_kernel(e, values)
+    return values, principal_direction(e, "strain")
 
 
 def equivalent_strain(strain: np.ndarray, nu: float = 0.0, plane: str = "strain") -> np.ndarray:
@@ -138,11 +130,10 @@ def equivalent_strain(strain: np.ndarray, nu: float = 0.0, plane: str = "strain"
     Returns:
         Shape ``(m,)`` [-].
     """
-    e = np.asarray(strain, float).reshape(-1, 3)
-    values, _ = principal_strains(e)
-    pos = np.maximum(values, 0.0)
-    ezz = np.maximum(_out_of_plane(e, nu, plane), 0.0)
-    return np.sqrt(pos[:, 0] ** 2 + pos[:, 1] ** 2 + ezz**2)
+    e = np.ascontiguousarray(strain, float).reshape(-1, 3)
+    eq = np.empty(len(e))
+    law.equivalent_strain_kernel(e, out_of_plane_ratio(nu, plane), eq)
+    return eq
 
 
 def equivalent_strain_gradient(strain: np.ndarray, nu: float = 0.0, plane: str = "strain") -> np.ndarray:
@@ -151,16 +142,17 @@ def equivalent_strain_gradient(strain: np.ndarray, nu: float = 0.0, plane: str =
     d eps_I / d eps = n_I (x) n_I, i.e. (n_x^2, n_y^2, n_x n_y) against engineering shear; where
     the principal strains coincide the sum sum <eps_I> n_I (x) n_I is still unique.
     """
-    e = np.asarray(strain, float).reshape(-1, 3)
+    e = np.ascontiguousarray(strain, float).reshape(-1, 3)
     values, n1 = principal_strains(e)
     n2 = np.column_stack([-n1[:, 1], n1[:, 0]])
     pos = np.maximum(values, 0.0)
     grad = np.zeros_like(e)
     for k, n in enumerate((n1, n2)):
         grad += pos[:, k:k + 1] * np.column_stack([n[:, 0] ** 2, n[:, 1] ** 2, n[:, 0] * n[:, 1]])
-    if plane == "stress":
-        ezz = np.maximum(_out_of_plane(e, nu, plane), 0.0)
-        grad[:, :2] -= (nu / (1.0 - nu) * ezz)[:, None]
+    r = out_of_plane_ratio(nu, plane)
+    if r:
+        ezz = np.maximum(-r * (e[:, 0] + e[:, 1]), 0.0)
+        grad[:, :2] -= (r * ezz)[:, None]
     eq = equivalent_strain(e, nu, plane)
     out = np.zeros_like(e)
     np.divide(grad, eq[:, None], out=out, where=eq[:, None] > 0)
@@ -173,15 +165,14 @@ def equivalent_strain_gradient(strain: np.ndarray, nu: float = 0.0, plane: str =
 def damage(kappa: np.ndarray, kappa0: np.ndarray | float, kappa_c: np.ndarray | float) -> np.ndarray:
     """Linear-softening damage D(kappa) of (4.2): 0 below kappa0, 1 beyond kappa_c (broadcasts).
 
-    Where kappa_c <= kappa0 the law has no softening branch and D jumps to 1 at kappa0.
+    Where kappa_c <= kappa0 the law has no softening branch and D jumps to 1 at kappa0
+    (``rkfx.damage_law.damage_at``).
     """
     kappa, kappa0, kappa_c = np.broadcast_arrays(*(np.asarray(a, float) for a in (kappa, kappa0, kappa_c)))
-    out = np.zeros(kappa.shape)
-    soft = (kappa >= kappa0) & (kappa_c > kappa0)
-    k = kappa[soft]
-    out[soft] = 1.0 - kappa0[soft] / k * (kappa_c[soft] - k) / (kappa_c[soft] - kappa0[soft])
-    out[(kappa >= kappa0) & ~(kappa_c > kappa0)] = 1.0  # no softening branch: perfectly brittle
-    return np.clip(out, 0.0, 1.0)
+    out = np.empty(kappa.shape)
+    law.damage_array_kernel(*(np.ascontiguousarray(a).reshape(-1) for a in (kappa, kappa0, kappa_c)),
+                            out.reshape(-1))
+    return out if out.ndim else out[()]
 
 
 def damage_slope(kappa: np.ndarray, kappa0: np.ndarray | float, kappa_c: np.ndarray | float) -> np.ndarray:
@@ -457,6 +448,28 @@ class DamageUpdate:
     dissipation: float
 
 
+def initiate(model: DamageModel, points: np.ndarray, effective: np.ndarray, normal: np.ndarray,
+             chord: np.ndarray, kappa_c: np.ndarray) -> None:
+    """Fix the crack of damage points at initiation, in place.
+
+    The crack normal n_L is the major principal direction of the effective stress C eps
+    (section 4.2.2); in the regularized model A_L is the chord of the point's cell across n_L
+    and kappa_c = band_factor (G_F / f_t) A_L / V_L (4.28) with the material's f_t.
+
+    Args:
+        model: Fixed point data.
+        points: Indices of the initiating points, shape ``(k,)`` (distinct).
+        effective: Their effective stresses C eps, shape ``(k, 3)`` [Pa].
+        normal: n_L of every point, shape ``(m, 2)``: rows ``points`` are written.
+        chord: A_L of every point, shape ``(m,)`` [m]: written when regularized.
+        kappa_c: Critical strains, shape ``(m,)``: written when regularized.
+    """
+    normal[points] = principal_direction(effective)
+    if model.regularized:
+        chord[points] = chord_lengths(model.geometry, points, normal[points])
+        kappa_c[points] = model.band_factor * critical_strain(model.material, chord[points], model.volume[points])
+
+
 def update(model: DamageModel, state: DamageState, strain: np.ndarray, tangent: bool = True,
            tangent_floor: float = 0.0, loading_tolerance: float = 0.0) -> DamageUpdate:
     """Damage, stress and tangent for the strains ``strain`` from the converged ``state``.
@@ -464,7 +477,9 @@ def update(model: DamageModel, state: DamageState, strain: np.ndarray, tangent: 
     kappa = max(kappa_old, eps_eq(strain)) (4.3)-(4.5). A point crossing its threshold for the
     first time fixes its crack normal along the major principal direction of the effective
     stress C eps and, in the regularized model, its kappa_c = (G_F / f_t) A_L / V_L (4.28) with
-    the material's f_t (the weakening factor only triggers localization).
+    the material's f_t (the weakening factor only triggers localization) (``initiate``).
+    eps_eq, kappa, D and the stress come from the compiled point updates of
+    ``rkfx.damage_law`` that the explicit force runs, with every point allowed to damage.
 
     Args:
         model: Fixed point data.
@@ -484,33 +499,32 @@ def update(model: DamageModel, state: DamageState, strain: np.ndarray, tangent: 
     brittle; ``check_regularization`` rejects such converged states.
     """
     mat = model.material
-    c = mat.elasticity()
-    e = np.asarray(strain, float).reshape(-1, 3)
-    eq = equivalent_strain(e, mat.nu, mat.plane)
-    kappa = np.maximum(state.kappa, eq)
-    effective = e @ c.T
+    elastic = mat.elastic
+    c = elastic.D()
+    e = np.ascontiguousarray(strain, float).reshape(-1, 3)
+    m = len(e)
+    everywhere = np.ones(m, bool)
+    eq, effective, crossing = np.empty(m), np.empty((m, 3)), np.empty(m, bool)  # crossing: unused here
+    law.strain_kernel_serial(e, c, elastic.out_of_plane_ratio, everywhere, state.damaged, model.kappa0, eq,
+                             effective, crossing)
+    trial = np.maximum(state.kappa, eq)
     # Points crossing their threshold now fix n_L and kappa_c; points within the loading
     # tolerance below it get prospective values for the tangent only.
-    near = ~state.damaged & (kappa >= (1.0 - loading_tolerance) * model.kappa0)
-    new = near & (kappa >= model.kappa0)
+    near = ~state.damaged & (trial >= (1.0 - loading_tolerance) * model.kappa0)
+    new = near & (trial >= model.kappa0)
     normal, kappa_c, chord = state.normal, state.kappa_c, state.chord
     if near.any():
         idx = np.flatnonzero(near)
-        s = effective[idx]
-        theta = 0.5 * np.arctan2(2.0 * s[:, 2], s[:, 0] - s[:, 1])
         normal, kappa_c, chord = normal.copy(), kappa_c.copy(), chord.copy()
-        normal[idx] = np.column_stack([np.cos(theta), np.sin(theta)])
-        if model.regularized:
-            chord[idx] = chord_lengths(model.geometry, idx, normal[idx])
-            kappa_c[idx] = model.band_factor * critical_strain(mat, chord[idx], model.volume[idx])
+        initiate(model, idx, effective[idx], normal, chord, kappa_c)
         prospective = np.flatnonzero(near & ~new)
         kc_tangent = kappa_c.copy()
         normal[prospective], chord[prospective] = state.normal[prospective], state.chord[prospective]
         kappa_c[prospective] = state.kappa_c[prospective]
     active = state.damaged | new
+    kappa, d, stress = state.kappa.copy(), np.zeros(m), np.empty((m, 3))
+    law.damage_kernel_serial(eq, effective, everywhere, active, model.kappa0, kappa_c, kappa, d, stress)
     kc = np.where(active, kappa_c, np.inf)
-    d = damage(kappa, model.kappa0, kc)
-    stress = (1.0 - d)[:, None] * effective
     phi_new = dissipation_density(kappa, model.kappa0, kc, mat.E)
     phi_old = dissipation_density(state.kappa, model.kappa0, kc, mat.E)
     diss = model.volume * (phi_new - phi_old)

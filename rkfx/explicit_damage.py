@@ -16,8 +16,10 @@ central-difference driver of ``rkfx.explicit``:
    steps 1 and 4 then run over the subcell rows, one product each way giving the smeared
    strains, the differences and the whole force (``rkfx.explicit.Stabilization``).
 
-Steps 2, 4 and 5 are compiled loops over the particles (in parallel); step 3 touches only
-the particles that initiate in this step.
+Steps 2, 4 and 5 are compiled loops over the particles (in parallel): steps 2 and 4 are the
+kernels of ``rkfx.damage_law``, whose point updates the quasi-static ``rkfx.damage.update``
+runs too. Step 3 (``rkfx.damage.initiate``, as in ``update``) touches only the particles that
+initiate in this step.
 
 Why the stabilization. Plain SCNI on a particle grid has zero-energy modes (the
 checkerboards that the cell-boundary integrals cannot see). Statics with supports hides
@@ -50,7 +52,8 @@ import numba
 import numpy as np
 
 from .crack_tracking import Tracking
-from .damage import DamageModel, chord_lengths, crack_opening, critical_strain, dissipation_density
+from .damage import DamageModel, crack_opening, dissipation_density, initiate
+from .damage_law import damage_kernel, strain_kernel
 from .errors import InputError
 from .explicit import Constraint, ExplicitDynamics, run_explicit
 from .ranks import on_root
@@ -69,47 +72,6 @@ class StrainOperator(Protocol):
     def strain(self, d: np.ndarray) -> np.ndarray: ...  # (m, 3) Voigt strains
 
     def force(self, stress: np.ndarray) -> np.ndarray: ...  # sum_L B_L^T Sigma_L V_L, (2 n,)
-
-
-@numba.njit(parallel=True, cache=True)
-def _equivalent_strain(strain, c, nu_zz, allowed, damaged, kappa0, eq, effective, crossing):
-    """Mazars' eps_eq (4.6) and C e per particle; ``crossing`` flags allowed undamaged
-    particles at or past their threshold. nu_zz = nu / (1 - nu) in plane stress, else 0."""
-    for i in numba.prange(strain.shape[0]):
-        exx = strain[i, 0]
-        eyy = strain[i, 1]
-        gxy = strain[i, 2]
-        mean = 0.5 * (exx + eyy)
-        r = np.sqrt(0.25 * (exx - eyy) ** 2 + 0.25 * gxy * gxy)
-        e1 = max(mean + r, 0.0)
-        e2 = max(mean - r, 0.0)
-        ezz = max(-nu_zz * (exx + eyy), 0.0)
-        eq[i] = np.sqrt(e1 * e1 + e2 * e2 + ezz * ezz)
-        for j in range(3):
-            effective[i, j] = c[j, 0] * exx + c[j, 1] * eyy + c[j, 2] * gxy
-        crossing[i] = allowed[i] and not damaged[i] and eq[i] >= kappa0[i]
-
-
-@numba.njit(parallel=True, cache=True)
-def _damage_stress(eq, effective, allowed, damaged, kappa0, kappa_c, kappa, damage, stress):
-    """kappa = max(kappa, eps_eq) where allowed, D(kappa) of (4.2) where damaged, and the
-    smeared stress (1 - D) C e (4.30)."""
-    for i in numba.prange(eq.shape[0]):
-        if allowed[i] and eq[i] > kappa[i]:
-            kappa[i] = eq[i]
-        d = 0.0
-        if damaged[i]:
-            k0 = kappa0[i]
-            kc = kappa_c[i]
-            k = kappa[i]
-            if not kc > k0 or k >= kc:
-                d = 1.0
-            elif k > k0:
-                d = 1.0 - k0 / k * (kc - k) / (kc - k0)
-            damage[i] = d
-        s = 1.0 - d
-        for j in range(3):
-            stress[i, j] = s * effective[i, j]
 
 
 @numba.njit(parallel=True, cache=True)
@@ -200,9 +162,9 @@ class DamageForce:
         if model.num_points != op.num_nodes:
             raise InputError(f"damage model has {model.num_points} points for {op.num_nodes} particles")
         self.op, self.model, self.field, self.track, self.dt = op, model, field, track, float(dt)
-        mat = model.material
-        self.c = np.ascontiguousarray(mat.elasticity())
-        self.nu_zz = mat.nu / (1.0 - mat.nu) if mat.plane == "stress" else 0.0
+        elastic = model.material.elastic
+        self.c = np.ascontiguousarray(elastic.D())
+        self.nu_zz = elastic.out_of_plane_ratio
         n = op.num_nodes
         self.kappa0 = np.ascontiguousarray(model.kappa0)
         self._eq = np.empty(n)
@@ -214,14 +176,14 @@ class DamageForce:
         f, op = self.field, self.op
         stab = getattr(op, "stabilization", None)
         e, diff = op.strains(d) if stab is not None else (op.strain(d), None)
-        _equivalent_strain(e, self.c, self.nu_zz, f.allowed, f.damaged, self.kappa0, self._eq, self._effective,
-                           self._crossing)
+        strain_kernel(e, self.c, self.nu_zz, f.allowed, f.damaged, self.kappa0, self._eq, self._effective,
+                      self._crossing)
         f.clock[0] += self.dt
         new = np.flatnonzero(self._crossing)
         if new.size:
             self._initiate(new)
-        _damage_stress(self._eq, self._effective, f.allowed, f.damaged, self.kappa0, f.kappa_c, f.kappa, f.damage,
-                       self.stress)
+        damage_kernel(self._eq, self._effective, f.allowed, f.damaged, self.kappa0, f.kappa_c, f.kappa, f.damage,
+                      self.stress)
         if stab is None:
             return op.force(self.stress)
         _subcell_stress(diff, self.c, stab.owner, f.damage, diff)
@@ -230,18 +192,12 @@ class DamageForce:
     def _initiate(self, new: np.ndarray) -> None:
         """Fix n_L (major principal direction of C e, 4.22) and kappa_c (4.28) of the particles
         ``new``; mark their tracking candidates."""
-        f, model = self.field, self.model
-        s = self._effective[new]
-        theta = 0.5 * np.arctan2(2.0 * s[:, 2], s[:, 0] - s[:, 1])
-        normal = np.column_stack([np.cos(theta), np.sin(theta)])
-        f.normal[new] = normal
-        if model.regularized:
-            f.chord[new] = chord_lengths(model.geometry, new, normal)
-            f.kappa_c[new] = model.band_factor * critical_strain(model.material, f.chord[new], model.volume[new])
+        f = self.field
+        initiate(self.model, new, self._effective[new], f.normal, f.chord, f.kappa_c)
         f.damaged[new] = True
         f.initiation_time[new] = f.clock[0]
         if self.track is not None and self.track.enabled:
-            cand, by = self.track.candidates(new, normal, f.parent)
+            cand, by = self.track.candidates(new, f.normal[new], f.parent)
             fresh = ~f.allowed[cand]
             f.parent[cand[fresh]] = by[fresh]
             f.allowed[cand] = True

@@ -95,7 +95,19 @@ class PoroMaterial:
 
 
 def fpp_parameter(material: PoroMaterial, dt: float, h: np.ndarray) -> np.ndarray:
-    """Stabilization parameter eps_f of eq. (3.53) for characteristic lengths h [1/Pa]."""
+    """Stabilization parameter eps_f of the fluid pressure projection, eqs. (3.53)-(3.54).
+
+    eps_f = <1 - 3 r> (1 + tanh(2 - 12 r)) / M' with r = c_v dt / h^2 (after Sun et al. 2013);
+    the RK solver and the FEM baseline (``fem_baselines.poroelasticity``) both use it.
+
+    Args:
+        material: The poroelastic solid (M' and c_v of eq. 3.54).
+        dt: Time step [s].
+        h: Characteristic lengths, any shape [m].
+
+    Returns:
+        eps_f, shaped like ``h`` [1/Pa].
+    """
     r = material.consolidation_coefficient * dt / np.asarray(h, float) ** 2
     return np.maximum(1.0 - 3.0 * r, 0.0) * (1.0 + np.tanh(2.0 - 12.0 * r)) / material.oedometric_storage_modulus
 

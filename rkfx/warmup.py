@@ -12,7 +12,7 @@ def warm_up() -> None:
     import numpy as np
 
     from .cracks import cracks
-    from .damage import DamageMaterial, cell_geometry, damage_model
+    from .damage import DamageMaterial, cell_geometry, damage_model, initial_state, update
     from .elasticity import ElasticMaterial
     from .explicit import lumped_mass, smeared_strain
     from .explicit_damage import run_damage
@@ -35,3 +35,4 @@ def warm_up() -> None:
     evaluate(rk_approximation(p.x, p.spacing, 1.75, cracks=crack), p.x, gradients=True)
     model = damage_model(DamageMaterial(1.0, 0.3, 1e-3, 1e-3), d.area, geometry=cell_geometry(p))
     run_damage("warm-up", smeared_strain(p, rk, d), lumped_mass(d.area, 1.0), 1e-3, model, None, (), 2e-3)
+    update(model, initial_state(model), np.tile([2e-3, 0.0, 0.0], (p.num_nodes, 1)))  # the quasi-static law

@@ -6,6 +6,8 @@ import pytest
 
 from rkfx import damage as dm
 from rkfx.cases import cracked_bar
+from rkfx.errors import InputError
+from verification.cohesive_bar import CohesiveBar
 
 NODES = [16, 32, 64, 128]
 WC = 2 * 1.885 / 200.0  # w_c = 2 G_F / f_t = u_T^max of the cohesive crack (4.9)
@@ -43,6 +45,21 @@ def test_regularized_failure_displacement_within_half_a_percent(seed, n):
 def test_summary_maps_node_counts_to_failure_displacements(seed):
     summary = next(r for r in seed.runs if r.method == "rkpm-scni" and r.info["study"] == "summary")
     assert set(summary.series["u_T_max"]) == {str(n) for n in NODES}
+
+
+def test_cohesive_reference_peaks_at_ft_A_and_spends_GF_A():
+    """(4.7)-(4.9) with the seed's data: elastic to f_t A at f_t L / E, no opening before it,
+    F = 0 and w = w_c at u_T = w_c; the work to break is G_F A (the path is piecewise linear,
+    so the trapezoid rule through its kinks is exact)."""
+    bar = CohesiveBar()
+    assert bar.critical_opening == WC and np.isclose(bar.force(bar.peak_displacement), 200.0 * 10.0, rtol=1e-14)
+    u = np.unique(np.r_[np.linspace(0.0, 1.2 * WC, 241), bar.peak_displacement, WC])
+    force, w = bar.force(u), bar.opening(u)
+    assert np.all(np.abs(w[u <= bar.peak_displacement]) < 1e-18) and np.all(force[u >= WC] == 0.0)
+    assert np.isclose(bar.opening(WC), WC, rtol=1e-14)
+    assert np.isclose(np.sum(0.5 * (force[1:] + force[:-1]) * np.diff(u)), GF_A, rtol=1e-12)
+    with pytest.raises(InputError, match="snaps back"):
+        CohesiveBar(GF=1e-3)
 
 
 def test_crack_opening_follows_the_cohesive_law(seed):

@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from rkfx.crack_tracking import principal_direction, tracking
+from rkfx.crack_tracking import tracking
+from rkfx.elasticity import principal_direction
 from rkfx.errors import InputError
 from rkfx.particles import structured
 

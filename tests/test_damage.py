@@ -56,6 +56,41 @@ def test_mazars_gradient_matches_finite_differences(plane):
         assert np.allclose(grad[:, k], fd, rtol=1e-5, atol=1e-9)
 
 
+def mazars_oracle(e, nu, plane):
+    """Mazars' eps_eq (4.6) in plain numpy: the test oracle of the compiled law."""
+    mean = 0.5 * (e[:, 0] + e[:, 1])
+    radius = np.hypot(0.5 * (e[:, 0] - e[:, 1]), 0.5 * e[:, 2])
+    ezz = -nu / (1 - nu) * (e[:, 0] + e[:, 1]) if plane == "stress" else np.zeros(len(e))
+    parts = np.maximum(np.column_stack([mean + radius, mean - radius, ezz]), 0.0)
+    return np.sqrt(np.sum(parts**2, axis=1))
+
+
+def damage_oracle(kappa, k0, kc):
+    """D(kappa) of (4.2) in plain numpy: the test oracle of the compiled law."""
+    kappa, k0, kc = np.broadcast_arrays(*(np.asarray(a, float) for a in (kappa, k0, kc)))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        soft = 1.0 - k0 / kappa * (kc - kappa) / (kc - k0)
+    return np.where(kappa < k0, 0.0, np.where(kc > k0, np.clip(soft, 0.0, 1.0), 1.0))
+
+
+@pytest.mark.parametrize("plane", ["strain", "stress"])
+def test_compiled_law_matches_the_numpy_oracle(plane):
+    rng = np.random.default_rng(7)
+    eps = rng.normal(size=(500, 3)) * 1e-4
+    assert np.allclose(dm.equivalent_strain(eps, 0.2, plane), mazars_oracle(eps, 0.2, plane), rtol=1e-13, atol=0)
+    k0 = 1e-4
+    kappa = np.r_[rng.uniform(0.0, 30 * k0, 500), k0, 20 * k0]
+    for kc in (20 * k0, 0.5 * k0):
+        assert np.allclose(dm.damage(kappa, k0, kc), damage_oracle(kappa, k0, kc), rtol=1e-14, atol=0)
+    # The smeared stress of update is (1 - D) C eps with D of the oracle.
+    model = dm.damage_model(dm.DamageMaterial(1.0, 0.2, 1e-4, 1e-5, plane), np.ones(500), kappa_c=20 * k0,
+                            regularized=False)
+    up = dm.update(model, dm.initial_state(model), eps, tangent=False)
+    d = damage_oracle(mazars_oracle(eps, 0.2, plane), k0, 20 * k0)
+    assert np.allclose(up.state.damage, d, rtol=1e-12, atol=1e-15)
+    assert np.allclose(up.stress, (1 - d)[:, None] * eps @ model.material.elasticity().T, rtol=1e-12, atol=1e-18)
+
+
 # --------------------------------------------------------------------------- damage law (4.2)
 
 

@@ -19,9 +19,9 @@ from mpi4py import MPI  # noqa: E402
 from fem_baselines.assembly_timing import time_p1_assembly  # noqa: E402
 from fem_baselines.elasticity import (  # noqa: E402
     errors,
-    lame_plane_strain,
     solve_plane_strain,
 )
+from rkfx.elasticity import ElasticMaterial  # noqa: E402
 
 E_MMS, NU_MMS = 1.0, 0.3
 SIDES = ("left", "right", "bottom", "top")
@@ -92,7 +92,7 @@ def grad_u_mms(x: np.ndarray) -> np.ndarray:
 
 def f_mms(x: np.ndarray) -> np.ndarray:
     """Body force -div sigma(u_mms), x (2, npts) -> (2, npts)."""
-    lam, mu = lame_plane_strain(E_MMS, NU_MMS)
+    lam, mu = ElasticMaterial(E_MMS, NU_MMS).lame
     p2 = np.pi**2
     sc = np.sin(np.pi * x[0]) * np.cos(np.pi * x[1])
     cs = np.cos(np.pi * x[0]) * np.sin(np.pi * x[1])
@@ -112,7 +112,7 @@ def u_mms_ufl(X):
 
 def _stress(G: np.ndarray, E: float, nu: float) -> np.ndarray:
     """Plane-strain stress from displacement gradient(s) G (2, 2, ...)."""
-    lam, mu = lame_plane_strain(E, nu)
+    lam, mu = ElasticMaterial(E, nu).lame
     eps = 0.5 * (G + np.swapaxes(G, 0, 1))
     tr = eps[0, 0] + eps[1, 1]
     return lam * tr * np.eye(2).reshape((2, 2) + (1,) * (G.ndim - 2)) + 2.0 * mu * eps

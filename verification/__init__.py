@@ -6,4 +6,6 @@
     mandel         Mandel's squeezed slab (Abousleiman et al. 1996), general Biot, S = 0 explicit
     strip_load     strip load on a drained poroelastic half-plane (Schiffman, Chen & Jordan 1969),
                    incompressible constituents, closed form in Fourier space + quadrature
+    cohesive_bar   bar under tension breaking along one crack with the linear cohesive law
+                   (Wei 2018, eqs. 4.7-4.9): force and crack opening against the tip displacement
 """

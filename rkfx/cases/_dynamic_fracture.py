@@ -25,7 +25,6 @@ import numpy as np
 from .. import damage as dm
 from ..crack_tracking import Tracking
 from ..cracks import Cracks, cracks
-from ..elasticity import ElasticMaterial
 from ..explicit import (
     Constraint,
     SmearedStrain,
@@ -84,7 +83,7 @@ def plate(xs: np.ndarray, ys: np.ndarray, slits: Sequence, tips: Sequence[tuple[
     rk = rk_approximation(p.x, p.spacing, support_factor, cracks=c)
     domains = grid_domains(xs, ys, slits)
     op = smeared_strain(p, rk, domains, eps_p)
-    dt = stable_time_step(p.spacing, ElasticMaterial(material.E, material.nu), rho, courant)
+    dt = stable_time_step(p.spacing, material.elastic, rho, courant)
     return Plate(np.asarray(xs, float), np.asarray(ys, float), p, rk, domains, op, lumped_mass(domains.area, rho),
                  dt, c)
 

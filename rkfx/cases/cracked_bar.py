@@ -6,7 +6,8 @@ breaks at a weak section x = L / 2. The cohesive zone model with the linear law 
 the reference path (4.9), u_T = F L / (E A) + w_c (1 - F / (f_t A)), w_c = 2 G_F / f_t: the
 force vanishes at u_T^max = w_c = 2 G_F A / (f_t A) = 1.885e-2 for the seed's data (L = 100,
 A = 10, E = 2e6, G_F = 1.885, f_t = 200, nu = 0; dimensionless units). With kappa0 weakened
-to 0.999 kappa0 the peak is 0.999 f_t A and the energy to break 0.999 G_F A.
+to 0.999 kappa0 the peak is 0.999 f_t A and the energy to break 0.999 G_F A. The reference is
+``verification.cohesive_bar``.
 
 Model. A 2-D strip [0, L] x [0, H] with two rows of n nodes (``rkfx.particles.structured``),
 H = h = L / (n - 1) (square cells at every n) and thickness A / H, in plane stress with nu = 0
@@ -97,6 +98,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+
+from verification.cohesive_bar import CohesiveBar
 
 from .. import damage as dm
 from ..damage_bar import (
@@ -214,19 +217,6 @@ def weak_points(s: Strip, L: float) -> np.ndarray:
     return (s.extent[:, 0] <= 0.5 * L + tol) & (s.extent[:, 1] >= 0.5 * L - tol)
 
 
-def czm_force(u: np.ndarray, L: float, A: float, E: float, GF: float, ft: float) -> np.ndarray:
-    """Tip force of the cohesive zone model (4.9): elastic up to f_t A, then linear softening."""
-    u = np.asarray(u, float)
-    wc = 2.0 * GF / ft
-    soft = (u - wc) / (L / (E * A) - wc / (ft * A))
-    return np.clip(np.minimum(E * A * u / L, soft), 0.0, None)
-
-
-def czm_opening(u: np.ndarray, L: float, A: float, E: float, GF: float, ft: float) -> np.ndarray:
-    """Crack opening w = u_T - F L / (E A) of the cohesive zone model (4.8)."""
-    return np.asarray(u, float) - czm_force(u, L, A, E, GF, ft) * L / (E * A)
-
-
 # --------------------------------------------------------------------------- the case
 
 
@@ -250,10 +240,7 @@ def _check(E, GF, ft, L, A, nodes, weak_factor, steps, u_end, stress_at, support
     for c in cells:
         if c not in CELLS:
             raise InputError(f"unknown cells {c!r}; choose from {', '.join(CELLS)}")
-    if not 2 * GF / ft > ft / E * L:
-        raise InputError(f"w_c = 2 GF / ft = {2 * GF / ft:.3g} must exceed the elastic elongation ft L / E = "
-                         f"{ft * L / E:.3g}, or the bar snaps back at the peak whatever the model; raise GF or "
-                         "lower L")
+    CohesiveBar(L, A, E, GF, ft)  # w_c must exceed the elastic elongation f_t L / E
 
 
 def _targets(u_peak: float, wc: float, steps: int, u_end: float, weak_factor: float = 0.999) -> np.ndarray:
@@ -278,9 +265,13 @@ def _curve_errors(u, force, dissipated, elastic, prm) -> dict:
             "F_max_over_ft_A": float(force.max()) / (ft * A), "F_end_over_ft_A": float(force[-1]) / (ft * A)}
 
 
+def _cohesive_bar(prm) -> CohesiveBar:
+    return CohesiveBar(*(prm[k] for k in ("L", "A", "E", "GF", "ft")))
+
+
 def _reference(u, prm) -> dict:
-    L, A, E, GF, ft = (prm[k] for k in ("L", "A", "E", "GF", "ft"))
-    return {"F_czm": czm_force(u, L, A, E, GF, ft), "w_czm": czm_opening(u, L, A, E, GF, ft)}
+    bar = _cohesive_bar(prm)
+    return {"F_czm": bar.force(u), "w_czm": bar.opening(u)}
 
 
 def _io(label: str, io: dict) -> dict:
@@ -463,9 +454,10 @@ def plot(results: Results, out: Path) -> list[Path]:
     files = []
     title = (f"cracked bar: L = {L:g}, A = {A:g}, E = {E:g}, $G_F$ = {GF:g}, $f_t$ = {ft:g}, "
              f"$w_c = 2G_F/f_t$ = {wc:.4g}")
-    for name, key, ylabel, ref in (("load_displacement", "F", "tip force F", czm_force),
+    bar = _cohesive_bar(prm)
+    for name, key, ylabel, ref in (("load_displacement", "F", "tip force F", bar.force),
                                    ("crack_opening", "cod", "crack opening $w = \\int D\\,\\varepsilon\\,dx$ (4.13)",
-                                    czm_opening)):
+                                    bar.opening)):
         if not groups:
             break
         fig, axes = _panels(plt, len(groups))
@@ -475,7 +467,7 @@ def plot(results: Results, out: Path) -> list[Path]:
             for r in runs:
                 ax.plot(np.asarray(r.series["u"]) / wc, r.series[key], **styles[r.info["nodes"]],
                         label=f"n = {r.info['nodes']}")
-            ax.plot(u_ref / wc, ref(u_ref, L, A, E, GF, ft), color="k", ls="--", lw=1.0, label="CZM (4.9)")
+            ax.plot(u_ref / wc, ref(u_ref), color="k", ls="--", lw=1.0, label="CZM (4.9)")
             ax.set_title(panel, fontsize=10)
             ax.set_xlabel("tip displacement $u_T / w_c$")
             ax.grid(alpha=0.3)

@@ -119,8 +119,9 @@ def mesh_plate(a: float, L: float, h: float):
 
 
 def _stress_xx(grad: np.ndarray, m: ElasticMaterial) -> np.ndarray:
-    """sigma_xx [Pa] from displacement gradients (k, 2, 2) in plane strain."""
-    return (m.lame_lambda + 2 * m.shear_modulus) * grad[:, 0, 0] + m.lame_lambda * grad[:, 1, 1]
+    """sigma_xx [Pa] from displacement gradients (k, 2, 2) by the law of ``m``."""
+    d = m.D()
+    return d[0, 0] * grad[:, 0, 0] + d[0, 1] * grad[:, 1, 1]
 
 
 def _fem_sigma_xx(result, m: ElasticMaterial, points: np.ndarray) -> np.ndarray:
@@ -130,8 +131,9 @@ def _fem_sigma_xx(result, m: ElasticMaterial, points: np.ndarray) -> np.ndarray:
     import dolfinx.fem  # noqa: PLC0415
     import ufl  # noqa: PLC0415
 
-    eps = ufl.sym(ufl.grad(result.u))
-    sig = m.lame_lambda * ufl.tr(eps) * ufl.Identity(2) + 2 * m.shear_modulus * eps
+    from fem_baselines.elasticity import stress_law  # noqa: PLC0415
+
+    sig = stress_law(result.mesh, m)(result.u)
     space = dolfinx.fem.functionspace(result.mesh, ("DG", result.degree - 1, (2,)))
     s = dolfinx.fem.Function(space)
     s.interpolate(dolfinx.fem.Expression(ufl.as_vector([sig[0, 0], sig[1, 1]]),
