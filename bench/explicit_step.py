@@ -3,7 +3,8 @@
 For each size, a uniform grid on a 0.1 m square (Kalthoff's plate, seed 4.3.2) with steel
 (E = 1.9e11 Pa, nu = 0.3, rho = 8000 kg/m^3): the smeared strain operator B~ (the smoothed
 gradient rows and their transpose, ``rkfx.explicit.smeared_strain``) is built once (``setup``:
-RK rows, nodal domains, B~; not part of the step); then ``run_explicit`` takes steps with the
+RK rows, nodal domains, B~; not part of the step); then central differences
+(``rkfx.solvers.central_difference.run_explicit``) take steps with the
 linear elastic force f_int = B~^T V D B~ d, a roller on the symmetry plane (bottom) and a
 prescribed velocity on the lower half of the left edge (the impact), both by the lumped-mass
 projection. ``f_int`` is the two sparse products alone (operator cache-warm, so a lower
@@ -28,8 +29,8 @@ KALTHOFF_T, KALTHOFF_NODES, IMPACT_V = 80e-6, 202_500, 16.5
 def measure(num_nodes: int, steps: int, courant: float) -> dict:
     from rkfx.boundary import Dirichlet
     from rkfx.elasticity import ElasticMaterial
-    from rkfx.explicit import (ExplicitDynamics, constraint, elastic_force, lumped_mass, run_explicit,
-                               smeared_strain, stable_time_step)
+    from rkfx.explicit import constraint, elastic_force, lumped_mass, smeared_strain, stable_time_step
+    from rkfx.solvers.central_difference import ExplicitDynamics, run_explicit
     from rkfx.nodal_domains import nodal_domains
     from rkfx.particles import structured
     from rkfx.shape_functions import rk_approximation

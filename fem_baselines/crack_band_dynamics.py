@@ -22,7 +22,7 @@ the tip node (a1, a2). ``dolfinx.io.gmsh.model_to_mesh`` converts the model.
 Discretisation. Linear triangles (vector P1): constant strain per cell. dolfinx assembles
 
     * the lumped mass, M_i = rho int N_i dx per component (row sums of the consistent
-      mass), interleaved per node like ``rkfx.explicit`` expects;
+      mass), interleaved per node like the particle models of ``rkfx.explicit``;
     * the strain operator B (rows (eps_xx, eps_yy, gamma_xy) of each cell, columns the
       interleaved nodal displacements) from the mixed form int eps(u) : tau dx with tau
       in a DG0 (3,) space, divided by the cell areas; it is kept as scipy CSR with B^T.
@@ -38,14 +38,15 @@ the major principal direction of the effective stress C eps. Any cell may damage
 no crack tracking. ``regularized=False`` uses one given kappa_c for every cell instead (the
 mesh-dependent, unregularized comparison).
 
-Time integration: central differences with the lumped mass (``rkfx.explicit.run_explicit``),
+Time integration: central differences with the lumped mass
+(``rkfx.solvers.central_difference.CentralDifference``), driven through the explicit model
+``rkfx.explicit_damage.DamageDynamics`` by ``run_damage`` as for the particles, with
 essential conditions as rows of the identity (``Constraint``): for Kalthoff u_y = 0 on y = 0
-and the impact velocity on the impact edge; the branching plate has none. The internal-force
-callable updates the damage history in place (it is called once per step with the new
-displacement); the history arrays are the run's ``extra_state``, so checkpoints and
-``resume`` restore them. The dissipated energy is accumulated per step from the exact
-dissipation density (``dissipation_density``) of the cells whose history grew, and is part
-of the extra state too.
+and the impact velocity on the impact edge; the branching plate has none. The internal force
+updates the damage history in place (it is called once per step with the new displacement);
+the history arrays are the model's ``state()``, so checkpoints and ``resume`` restore them.
+The dissipated energy is the exact dissipation density (``dissipation_density``) of the
+cells, summed at every sample.
 
 Stable step: dt = courant * min_e(a_e) / c_d with a_e the smallest altitude of cell e and
 c_d = sqrt((lambda + 2 mu) / rho).
@@ -79,9 +80,10 @@ import ufl
 from rkfx import damage as dm
 from rkfx.errors import InputError
 from rkfx.elasticity import ElasticMaterial
-from rkfx.explicit import Constraint, dilatational_wave_speed
+from rkfx.explicit import dilatational_wave_speed
 from rkfx.explicit_damage import DamageRun, run_damage, run_key
 from rkfx.ranks import on_root
+from rkfx.solvers.central_difference import Constraint
 
 __all__ = [
     "CellStrain",

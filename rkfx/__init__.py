@@ -16,7 +16,7 @@ The numerical core (this package's top-level modules) needs only numpy, scipy an
     damage           damage particle method: Mazars strain, damage law, energy regularization (ch. 4)
     damage_law       Mazars' strain and the softening law compiled, shared by statics and dynamics
     cracks           pre-existing cracks: diffraction of the kernel supports round crack tips
-    explicit         central-difference dynamics with lumped mass, constraints, checkpoints
+    explicit         explicit models: smeared strain B~ (SCNI, MSCNI), lumped mass, stable step
     crack_tracking   candidate damage particles along crack segments (eq. 4.22)
     explicit_damage  damage particle method in explicit dynamics: compiled update, runs kept on disk
     linear_solver    factorized systems through PETSc when installed, else SciPy

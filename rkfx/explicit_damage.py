@@ -1,7 +1,7 @@
 """The damage particle method in explicit dynamics: smeared-strain damage with particle tracking.
 
 One internal-force evaluation of the damage particle method (eqs. 4.29-4.35) for the
-central-difference driver of ``rkfx.explicit``:
+central-difference stepper of ``rkfx.solvers.central_difference``:
 
 1. smeared strains of every particle, e~_L = B~(x_L) d (4.31), one sparse product;
 2. Mazars' equivalent strain (4.6) and, for particles allowed to damage, the history
@@ -33,14 +33,17 @@ their stiffness (factor 1 - D_L), so it never holds a crack closed.
 Particle tracking (section 4.2.2, ``rkfx.crack_tracking``): only allowed particles may
 initiate, and a particle's initiation makes its candidates of (4.22) allowed.
 
-All history lives in the arrays of ``DamageField``, updated in place, which the explicit
-driver checkpoints (``DamageField.arrays`` as ``extra_state``). ``run_damage`` runs a model
-and keeps finished work: with a work directory each finished run is written to
-``WORK/<label>/result.npz`` and, with ``checkpoint_every``, its state to
-``WORK/<label>/checkpoint.npz`` as it runs; resuming reads a finished run back and continues
-an interrupted one from its checkpoint. The sampled history (time, dissipated energy,
-damaged points, energies) lives in a fixed array checkpointed with the damage history, so a
-resumed run reports the same history as an uninterrupted one.
+``DamageDynamics`` is the explicit model (``rkfx.solvers.central_difference.ExplicitModel``):
+lumped mass, essential conditions, external force and the ``DamageForce`` of a strain
+operator. All history lives in the arrays of ``DamageField``, updated in place by the force
+(the commit of an explicit step); they are the model's ``state()``, which the stepper
+checkpoints and restores. ``run_damage`` runs a model and keeps finished work: with a work
+directory each finished run is written to ``WORK/<label>/result.npz`` and, with
+``checkpoint_every``, its state to ``WORK/<label>/checkpoint.npz`` as it runs; resuming reads
+a finished run back and continues an interrupted one from its checkpoint. The sampled
+history (time, dissipated energy, damaged points, energies) is the stepper's recorder, a
+fixed array checkpointed with the damage history, so a resumed run reports the same history
+as an uninterrupted one.
 """
 import time
 from collections.abc import Callable, Sequence
@@ -55,8 +58,9 @@ from .crack_tracking import Tracking
 from .damage import DamageModel, crack_opening, dissipation_density, initiate
 from .damage_law import damage_kernel, strain_kernel
 from .errors import InputError
-from .explicit import Constraint, ExplicitDynamics, run_explicit
 from .ranks import on_root
+from .solvers.central_difference import CentralDifference, Constraint, ExplicitDynamics, ExplicitState
+from .solvers.checkpoint import copy_into
 
 HISTORY = ("time", "dissipated", "damaged", "kinetic", "internal", "external")
 
@@ -118,7 +122,7 @@ class DamageField:
 
     @property
     def arrays(self) -> dict[str, np.ndarray]:
-        """The arrays by name (for ``run_explicit(extra_state=...)``: checkpointed, restored in place)."""
+        """The arrays by name (the ``state()`` of ``DamageDynamics``: checkpointed, restored in place)."""
         return {k: getattr(self, k) for k in ("kappa", "damage", "normal", "kappa_c", "chord", "damaged",
                                               "allowed", "initiation_time", "parent", "clock")}
 
@@ -151,7 +155,7 @@ def damage_field(model: DamageModel, track: Tracking | None = None, dt: float = 
 
 
 class DamageForce:
-    """f_int(d) of the damage particle method (eq. 4.34) for ``rkfx.explicit.run_explicit``.
+    """f_int(d) of the damage particle method (eq. 4.34), the internal force of ``DamageDynamics``.
 
     Called once per step with the new coefficients; it advances the history in ``field``
     and its clock by ``dt`` (the clock only stamps initiation times).
@@ -201,6 +205,60 @@ class DamageForce:
             fresh = ~f.allowed[cand]
             f.parent[cand[fresh]] = by[fresh]
             f.allowed[cand] = True
+
+
+class DamageDynamics(ExplicitDynamics):
+    """M d'' = f_ext(t) - f_int(d) with the damage particle method's internal force: the
+    explicit model of a damage run, whose history (``state()``) is its ``DamageField``.
+
+    Args:
+        op: Strain operator of the damage points.
+        mass: Lumped mass per unknown, shape ``(2 n,)`` [kg].
+        model, track: Damage points and tracking (``None``: every point may damage).
+        dt: Time step [s] (the force's clock stamps initiation times with it).
+        constraints, external_force: Essential conditions and f_ext(t) (``None``: no load).
+    """
+
+    def __init__(self, op: StrainOperator, mass: np.ndarray, model: DamageModel, track: Tracking | None, dt: float,
+                 constraints: Sequence[Constraint] = (), external_force: Callable[[float], np.ndarray] | None = None):
+        self.op, self.damage_model = op, model
+        self.field = damage_field(model, track, dt)
+        self.force = DamageForce(op, model, self.field, track, dt)
+        super().__init__(mass, self.force, dt, external_force, constraints, self.field.arrays)
+
+
+class _Samples:
+    """The sampled history of a damage run (the stepper's recorder): time, dissipated energy,
+    damaged points and energies at every output, and the stepping time so far across the
+    pieces of a resumed run; its arrays are checkpointed with the run."""
+
+    def __init__(self, dynamics: DamageDynamics, steps: int, every: int):
+        self.field, self.model = dynamics.field, dynamics.damage_model
+        self.history = np.full((steps // every + 2, len(HISTORY)), np.nan)
+        self.slot = np.zeros(1, np.int64)
+        self.wall = np.zeros(1)
+        self.base = None  # the earlier pieces' stepping time, read at this piece's first output
+        self.t0 = time.perf_counter()  # the start of this piece
+
+    def record(self, s: ExplicitState) -> None:
+        if self.base is None:
+            self.base = float(self.wall[0])
+        self.wall[0] = self.base + time.perf_counter() - self.t0
+        e = s.energy
+        self.history[self.slot[0]] = (s.time, self.field.dissipated(self.model), self.field.damaged.sum(),
+                                      e[0], e[1], e[2] + e[3])
+        self.slot[0] += 1
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        return {"history": self.history, "slot": self.slot, "wall": self.wall}
+
+    def restore(self, arrays) -> None:
+        copy_into(self.arrays(), arrays, "run history")
+
+    @property
+    def elapsed(self) -> float:
+        """Stepping time of the run so far, earlier pieces included [s]."""
+        return (self.base or 0.0) + time.perf_counter() - self.t0
 
 
 # --------------------------------------------------------------------------- runs
@@ -282,7 +340,7 @@ def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, mode
         op, mass, dt: Strain operator of the damage points, lumped mass per unknown [kg] and
             time step [s].
         model, track: Damage points and tracking (``None``: every point may damage).
-        constraints, external_force: As for ``rkfx.explicit.ExplicitDynamics``.
+        constraints, external_force: As for ``DamageDynamics``.
         checkpoint_every: Checkpoint every so many steps (needs ``work_dir``).
         work_dir: Where finished results and checkpoints go.
         resume: Work directory of an interrupted invocation: a finished result there is
@@ -303,33 +361,18 @@ def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, mode
         return DamageRun.load(Path(resume) / key / "result.npz")
     steps = int(np.ceil(t_end / dt - 1e-9))
     every = max(1, steps // samples)
-    field = damage_field(model, track, dt)
-    force = DamageForce(op, model, field, track, dt)
-    history = np.full((steps // every + 2, len(HISTORY)), np.nan)
-    slot = np.zeros(1, np.int64)
-    wall = np.zeros(1)  # stepping time so far, across the pieces of a resumed run
-    base: list[float] = []
-
-    def record(s):
-        if not base:  # the first output of this piece: wall holds the earlier pieces' time
-            base.append(float(wall[0]))
-        wall[0] = base[0] + time.perf_counter() - t0
-        e = s.energy
-        history[slot[0]] = (s.time, field.dissipated(model), field.damaged.sum(), e[0], e[1], e[2] + e[3])
-        slot[0] += 1
-
-    problem = ExplicitDynamics(mass, force, dt, external_force, constraints)
-    extra = {**field.arrays, "history": history, "slot": slot, "wall": wall}
     start = None
     checkpoint_dir = None if work_dir is None else Path(work_dir) / key
     if resume is not None and (Path(resume) / key / "checkpoint.npz").is_file():
         start = Path(resume) / key
-    t0 = time.perf_counter()
-    res = run_explicit(problem, steps, extra_state=extra, output_every=every, on_output=record,
-                       checkpoint_every=checkpoint_every, checkpoint_dir=checkpoint_dir, resume=start)
-    elapsed = (base[0] if base else 0.0) + time.perf_counter() - t0
+    dynamics = DamageDynamics(op, mass, model, track, dt, constraints, external_force)
+    kept = _Samples(dynamics, steps, every)
+    res = CentralDifference(dt).run(dynamics, steps, output_every=every, recorder=kept,
+                                    checkpoint_every=checkpoint_every, checkpoint_dir=checkpoint_dir, resume=start)
+    elapsed = kept.elapsed
+    history, slot, field = kept.history, kept.slot, dynamics.field
     if slot[0] == 0 or history[slot[0] - 1, 0] < steps * dt * (1 - 1e-12):
-        record(res.state)
+        kept.record(res.state)
     run = DamageRun(label, history[:slot[0]].copy(), field.damage.copy(), field.kappa.copy(), field.normal.copy(),
                     field.initiation_time.copy(), crack_opening(field.kappa, model.kappa0, field.kappa_c),
                     field.dissipation(model), res.state.d.copy(), res.state.v.copy(), steps, dt, elapsed,

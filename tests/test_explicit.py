@@ -5,14 +5,16 @@ import pytest
 from rkfx.boundary import Dirichlet, Traction, boundary_quadrature, traction_load
 from rkfx.elasticity import ElasticMaterial
 from rkfx.errors import InputError
-from rkfx.explicit import (CHECKPOINT, Constraint, ExplicitDynamics, constraint, dilatational_wave_speed,
-                           elastic_force, load_checkpoint, lumped_mass, max_frequency, run_explicit,
+from rkfx.explicit import (constraint, dilatational_wave_speed, elastic_force, lumped_mass, max_frequency,
                            smeared_strain, stable_time_step)
 from rkfx.nodal_domains import nodal_domains
 from rkfx.operators import stiffness, strain_matrix
 from rkfx.particles import structured
 from rkfx.quadrature import scni, smoothed_gradients
 from rkfx.shape_functions import evaluate, rk_approximation
+from rkfx.solvers.central_difference import Constraint, ExplicitDynamics, run_explicit
+from rkfx.solvers.checkpoint import CHECKPOINT
+from rkfx.solvers.checkpoint import load_arrays as load_checkpoint
 
 
 def setup(p, material, rho=1.0):

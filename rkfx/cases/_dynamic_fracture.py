@@ -3,7 +3,8 @@
 A plate is a tensor grid of particles whose rectangular Voronoi cells (``rkfx.grid_cells``)
 have faces along the pre-existing cracks, so no cell straddles a crack; the RK shape
 functions see the cracks by diffraction (``rkfx.cracks``). The damage particle method
-(``rkfx.explicit_damage``) runs in ``rkfx.explicit``'s central-difference driver.
+(``rkfx.explicit_damage``) runs as a ``DamageDynamics`` model on the central-difference
+stepper (``rkfx.solvers.central_difference``).
 
 ``simulate`` runs a model on a plate through ``rkfx.explicit_damage.run_damage``, which
 keeps finished work (checkpoints, finished results read back on resume).
@@ -25,18 +26,13 @@ import numpy as np
 from .. import damage as dm
 from ..crack_tracking import Tracking
 from ..cracks import Cracks, cracks
-from ..explicit import (
-    Constraint,
-    SmearedStrain,
-    lumped_mass,
-    smeared_strain,
-    stable_time_step,
-)
+from ..explicit import SmearedStrain, lumped_mass, smeared_strain, stable_time_step
 from ..explicit_damage import DamageRun, run_damage
 from ..grid_cells import grid_domains
 from ..nodal_domains import NodalDomains
 from ..particles import Particles, graded
 from ..shape_functions import RKApproximation, rk_approximation
+from ..solvers.central_difference import Constraint
 
 CRACKED = 0.5  # w / w_c from which a particle counts as cracked (half its fracture energy spent)
 

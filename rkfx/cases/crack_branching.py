@@ -21,8 +21,9 @@ between the two branches and striped damage), the damage law (4.2) with Mazars' 
 kappa_c = (G_F / f_t) A_L / V_L (4.28) and particle tracking (4.22) with tol = 0.5; the
 particles within 0.75 h of the crack tip are the seeds. The traction load is the RK boundary
 integral f_I = sum over the top and bottom half-segments of N_I(midpoint) t length
-(``rkfx.boundary.traction_load``, SCNI's one-point rule). Central differences with the lumped
-mass and dt = 0.5 h / c_d (``rkfx.explicit``) to ``t_end`` = 80 microseconds.
+(``rkfx.boundary.traction_load``, SCNI's one-point rule). Central differences
+(``rkfx.solvers.central_difference``) with the lumped mass and dt = 0.5 h / c_d
+(``rkfx.explicit``) to ``t_end`` = 80 microseconds.
 
 Studies (``h`` lists nominal spacings [m]):
 

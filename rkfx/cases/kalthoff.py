@@ -21,7 +21,8 @@ dynamics needs it), the damage law (4.2) with Mazars' equivalent strain, the reg
 kappa_c = (G_F / f_t) A_L / V_L (4.28) and particle tracking (4.22) with tol = 0.3 within
 3.5 h, candidates only ahead of their particle (``rkfx.crack_tracking``); the four particles
 around the crack tip are the seeds.
-Central differences with the lumped mass and dt = 0.5 h / c_d (``rkfx.explicit``); the impact
+Central differences (``rkfx.solvers.central_difference``) with the lumped mass and
+dt = 0.5 h / c_d (``rkfx.explicit``); the impact
 velocity and the roller are collocation conditions imposed by projection. Each run goes to
 ``t_end`` = 80 microseconds.
 

@@ -8,6 +8,8 @@ steppers, one Newton, checkpoints.
     newmark        Newmark for second-order fields with the generalized trapezoid for
                    first-order ones (eqs. 5.18-5.22; explicit when beta = theta = 0,
                    eqs. 6.37-6.41); the theta-method (backward Euler, Crank-Nicolson)
+    central_difference  central differences with a lumped mass for explicit models:
+                   projected essential conditions, prescribed velocities, energies
     quasi_static   load stepping with step cutting and dissipation control (snap-backs)
     integrate      the time loop: step cutting, outputs, checkpoints and resume
     checkpoint     atomic checkpoint files

@@ -55,3 +55,12 @@ def prefixed(arrays: Mapping[str, np.ndarray], prefix: str) -> dict[str, np.ndar
 def unprefixed(arrays: Mapping[str, np.ndarray], prefix: str) -> dict[str, np.ndarray]:
     """The group of ``arrays`` stored under ``prefix``, without it."""
     return {k[len(prefix):]: v for k, v in arrays.items() if k.startswith(prefix)}
+
+
+def copy_into(targets: Mapping[str, np.ndarray], arrays: Mapping[str, np.ndarray], what: str = "array") -> None:
+    """Set every array of ``targets`` in place from the one of the same name in ``arrays`` (the
+    history of a resumed run, which its force or recorder holds on to)."""
+    for k, arr in targets.items():
+        if k not in arrays:
+            raise InputError(f"checkpoint has no {what} {k!r}; it holds {sorted(arrays)}")
+        arr[...] = arrays[k]
