@@ -23,10 +23,10 @@ import time
 def build(num_nodes: int) -> dict:
     import numpy as np
 
-    from rkfx.nodal_domains import nodal_domains
-    from rkfx.particles import structured
-    from rkfx.quadrature import mscni_stabilization, smoothed_gradients
-    from rkfx.shape_functions import rk_approximation
+    from rkfx.geometry.nodal_domains import nodal_domains
+    from rkfx.geometry.particles import structured
+    from rkfx.integration.quadrature import mscni_stabilization, smoothed_gradients
+    from rkfx.approximation.shape_functions import rk_approximation
 
     def once(n):
         side = int(round(np.sqrt(n)))

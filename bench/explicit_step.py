@@ -2,7 +2,7 @@
 
 For each size, a uniform grid on a 0.1 m square (Kalthoff's plate, seed 4.3.2) with steel
 (E = 1.9e11 Pa, nu = 0.3, rho = 8000 kg/m^3): the smeared strain operator B~ (the smoothed
-gradient rows and their transpose, ``rkfx.explicit.smeared_strain``) is built once (``setup``:
+gradient rows and their transpose, ``rkfx.assembly.smeared_strain.smeared_strain``) is built once (``setup``:
 RK rows, nodal domains, B~; not part of the step); then central differences
 (``rkfx.solvers.central_difference.run_explicit``) take steps with the
 linear elastic force f_int = B~^T V D B~ d, a roller on the symmetry plane (bottom) and a
@@ -27,13 +27,13 @@ KALTHOFF_T, KALTHOFF_NODES, IMPACT_V = 80e-6, 202_500, 16.5
 
 
 def measure(num_nodes: int, steps: int, courant: float) -> dict:
-    from rkfx.boundary import Dirichlet
-    from rkfx.elasticity import ElasticMaterial
-    from rkfx.explicit import constraint, elastic_force, lumped_mass, smeared_strain, stable_time_step
+    from rkfx.assembly.boundary import Dirichlet
+    from rkfx.materials.elasticity import ElasticMaterial
+    from rkfx.assembly.smeared_strain import constraint, elastic_force, lumped_mass, smeared_strain, stable_time_step
     from rkfx.solvers.central_difference import ExplicitDynamics, run_explicit
-    from rkfx.nodal_domains import nodal_domains
-    from rkfx.particles import structured
-    from rkfx.shape_functions import rk_approximation
+    from rkfx.geometry.nodal_domains import nodal_domains
+    from rkfx.geometry.particles import structured
+    from rkfx.approximation.shape_functions import rk_approximation
 
     side = int(round(math.sqrt(num_nodes)))
     p = structured(SIDE, SIDE, side, side)
@@ -82,8 +82,8 @@ def main(argv=None):
         print(f"{r['nodes']:>10,d} {r['nnz']:>12,d} {r['setup']:>10.2f} {1e3 * r['f_int']:>11.2f} "
               f"{1e3 * r['step']:>10.2f} {1e9 * r['dt']:>8.2f} {1e9 * r['step'] / r['nodes']:>13.1f}")
     # Kalthoff: 450 x 450 nodes on 0.1 m, h = 0.1 / 449 m.
-    from rkfx.elasticity import ElasticMaterial
-    from rkfx.explicit import dilatational_wave_speed
+    from rkfx.materials.elasticity import ElasticMaterial
+    from rkfx.assembly.smeared_strain import dilatational_wave_speed
 
     c_d = dilatational_wave_speed(ElasticMaterial(E, NU), RHO)
     h = SIDE / 449

@@ -24,11 +24,11 @@ def main(argv=None):
     ap.add_argument("--t-end", type=float, default=80e-6, help="end time [s]")
     args = ap.parse_args(argv)
 
-    from rkfx import damage as dm
+    from rkfx.fracture import damage as dm
     from rkfx.cases import _dynamic_fracture as dyn
     from rkfx.cases import kalthoff as k
-    from rkfx.crack_tracking import tracking
-    from rkfx.explicit_damage import DamageForce, damage_field
+    from rkfx.fracture.tracking import tracking
+    from rkfx.models.damage_dynamics import DamageForce, damage_field
     from rkfx.warmup import warm_up
 
     warm_up()

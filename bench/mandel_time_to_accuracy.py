@@ -18,8 +18,8 @@ import numpy as np
 
 import dolfinx_solver  # noqa: F401  (MPI before petsc4py)
 from fem_baselines import poroelasticity as fb
-from rkfx.particles import structured
-from rkfx.poroelasticity import Displacement, PoroMaterial, Pressure, solve_biot, time_grid, zero
+from rkfx.geometry.particles import structured
+from rkfx.models.poroelasticity import Displacement, PoroMaterial, Pressure, solve_biot, time_grid, zero
 from rkfx.warmup import warm_up
 from verification.mandel import Mandel
 

@@ -22,7 +22,7 @@ import dolfinx.mesh
 import ufl
 
 from fem_baselines.elasticity import strain, stress_law
-from rkfx.elasticity import ElasticMaterial
+from rkfx.materials.elasticity import ElasticMaterial
 
 __all__ = ["time_p1_assembly"]
 

@@ -8,7 +8,7 @@ prescribed tip displacement u_T:
     right (x = L)   u_x = u_T, u_y = 0
 
 Plane stress with nu = 0 (so the bar is uniaxial and u_y = 0 adds no reaction). Each element
-carries the damage law of ``rkfx.damage`` (Mazars' equivalent strain (4.6), linear softening
+carries the damage law of ``rkfx.fracture.damage`` (Mazars' equivalent strain (4.6), linear softening
 (4.2), irreversibility (4.3)-(4.5)) evaluated with its constant strain. Crack-band scaling
 (Bazant and Oh 1983): kappa_c = w_c / h_e with w_c = 2 G_F / f_t and the band width h_e = h,
 the element length along the bar, so that an element column failing completely dissipates
@@ -19,10 +19,10 @@ Solution: ``rkfx.solvers.quasi_static.march`` on ``CrackBandModel``, the same st
 RKPM bar: displacement control in sub-steps with step cutting (a crack band of one element
 column never snaps back when w_c > f_t L / E), each solved by the shared Newton with the
 consistent tangent (1 - D) C - D' (C eps) (x) d eps_eq / d eps (non-symmetric; MUMPS LU through
-``rkfx.linear_solver``). dolfinx assembles the residual and tangent; the Dirichlet conditions are
+``rkfx.linalg.linear_solver``). dolfinx assembles the residual and tangent; the Dirichlet conditions are
 unit rows of their dofs imposed with multipliers, whose sum over the right-end u_x dofs (times
 the thickness) is the tip force. The strain, stress and tangent live in DG0 spaces; the
-material update is ``rkfx.damage.update``, the law of the particles.
+material update is ``rkfx.fracture.damage.update``, the law of the particles.
 
 The mesh lives on one process (``MPI.COMM_SELF``): the bar has a few hundred unknowns; the
 linear solves take a communicator.
@@ -44,8 +44,8 @@ import dolfinx.fem
 import dolfinx.mesh
 import ufl
 
-from rkfx import damage as dm
-from rkfx.damage_bar import DamageHistory, LoadCurve
+from rkfx.fracture import damage as dm
+from rkfx.models.damage_bar import DamageHistory, LoadCurve
 from rkfx.errors import InputError
 from rkfx.solvers.fields import single
 from rkfx.solvers.model import Constraints
@@ -70,7 +70,7 @@ class CrackBandResult:
         x: Element centroids along the bar, shape ``(num_cells,)`` [m].
         damage_profile: Element damage at ``u_profile``, shape ``(num_cells,)``.
         u_profile: Tip displacement of the damage profile [m].
-        u_T_max: Tip displacement at complete failure (``rkfx.damage.failure_displacement``) [m].
+        u_T_max: Tip displacement at complete failure (``rkfx.fracture.damage.failure_displacement``) [m].
         n_dofs: Displacement unknowns.
         wall_time_s: Wall time of the load path (mesh, forms and solves) [s].
         iterations: Newton iterations over all steps.

@@ -22,12 +22,12 @@ the tip node (a1, a2). ``dolfinx.io.gmsh.model_to_mesh`` converts the model.
 Discretisation. Linear triangles (vector P1): constant strain per cell. dolfinx assembles
 
     * the lumped mass, M_i = rho int N_i dx per component (row sums of the consistent
-      mass), interleaved per node like the particle models of ``rkfx.explicit``;
+      mass), interleaved per node like the particle models of ``rkfx.assembly.smeared_strain``;
     * the strain operator B (rows (eps_xx, eps_yy, gamma_xy) of each cell, columns the
       interleaved nodal displacements) from the mixed form int eps(u) : tau dx with tau
       in a DG0 (3,) space, divided by the cell areas; it is kept as scipy CSR with B^T.
 
-Material (``rkfx.damage``): sigma = (1 - D) C eps, C plane strain; Mazars' equivalent strain
+Material (``rkfx.fracture.damage``): sigma = (1 - D) C eps, C plane strain; Mazars' equivalent strain
 (4.6) of the cell strain; history kappa = max(kappa_old, eps_eq) (4.3)-(4.5); linear
 softening D(kappa) (4.2) between kappa0 = f_t / E and kappa_c. Crack-band scaling (Bazant
 and Oh 1983): kappa_c = (G_F / f_t) / h_e with h_e the chord of the triangle through its
@@ -40,7 +40,7 @@ mesh-dependent, unregularized comparison).
 
 Time integration: central differences with the lumped mass
 (``rkfx.solvers.central_difference.CentralDifference``), driven through the explicit model
-``rkfx.explicit_damage.DamageDynamics`` by ``run_damage`` as for the particles, with
+``rkfx.models.damage_dynamics.DamageDynamics`` by ``run_damage`` as for the particles, with
 essential conditions as rows of the identity (``Constraint``): for Kalthoff u_y = 0 on y = 0
 and the impact velocity on the impact edge; the branching plate has none. The internal force
 updates the damage history in place (it is called once per step with the new displacement);
@@ -77,11 +77,11 @@ import dolfinx.io.gmsh
 import dolfinx.mesh
 import ufl
 
-from rkfx import damage as dm
+from rkfx.fracture import damage as dm
 from rkfx.errors import InputError
-from rkfx.elasticity import ElasticMaterial
-from rkfx.explicit import dilatational_wave_speed
-from rkfx.explicit_damage import DamageRun, run_damage, run_key
+from rkfx.materials.elasticity import ElasticMaterial
+from rkfx.assembly.smeared_strain import dilatational_wave_speed
+from rkfx.models.damage_dynamics import DamageRun, run_damage, run_key
 from rkfx.ranks import on_root
 from rkfx.solvers.central_difference import Constraint
 
@@ -110,7 +110,7 @@ MESH_FILE = "mesh.npz"  # the nodes and cells of a finished run, beside its resu
 
 def triangle_geometry(vertices: np.ndarray) -> dm.CellGeometry:
     """Each triangle as three convex quadrilaterals about its centroid g, (g, m_ca, a, m_ab)
-    and so on (counter-clockwise), so that ``rkfx.damage.chord_lengths`` gives the exact chord
+    and so on (counter-clockwise), so that ``rkfx.fracture.damage.chord_lengths`` gives the exact chord
     of the triangle through its centroid.
 
     Args:
@@ -333,7 +333,7 @@ def stable_time_step(m: CrackedPlateMesh, E: float, nu: float, rho: float, coura
 
 @dataclass(frozen=True)
 class CellStrain:
-    """The cell strains of linear triangles as the strain operator of ``rkfx.explicit_damage``:
+    """The cell strains of linear triangles as the strain operator of ``rkfx.models.damage_dynamics``:
     damage points are the cells, ``strain`` = B d, ``force`` = B^T (sigma area)."""
 
     ops: FemOperators
@@ -472,7 +472,7 @@ def kalthoff_crack_band(h: float, t_end: float = 80e-6, *, E: float = 1.9e11, nu
         kappa_c: Critical strain of the unregularized model [-] (only with ``regularized=False``).
         courant: Fraction of the stable step (0, 1].
         samples: History samples over the run.
-        label, checkpoint_every, work_dir, resume: As for ``rkfx.explicit_damage.run_damage``
+        label, checkpoint_every, work_dir, resume: As for ``rkfx.models.damage_dynamics.run_damage``
             (default label ``fem-crack-band h=<h>``).
         comm: Communicator; rank 0 computes and broadcasts the result.
 

@@ -12,7 +12,7 @@ rank 0, distributed over ``comm``), then the problem
 is solved with vector Lagrange P``degree`` elements on triangles and a direct
 MUMPS LU factorisation, with the plane-strain constitutive law
 ``sigma = lambda tr(eps) I + 2 mu eps``, lambda and mu from
-:class:`rkfx.elasticity.ElasticMaterial` (the law of the RKPM solvers).
+:class:`rkfx.materials.elasticity.ElasticMaterial` (the law of the RKPM solvers).
 
 Units are whatever the caller uses consistently (e.g. m, Pa, N/m^3); the
 module never rescales anything.
@@ -43,7 +43,7 @@ import dolfinx.io.gmsh
 import dolfinx.mesh
 import ufl
 
-from rkfx.elasticity import ElasticMaterial
+from rkfx.materials.elasticity import ElasticMaterial
 
 __all__ = [
     "FemElasticityResult",
@@ -82,7 +82,7 @@ def strain(w):
 def stress_law(mesh: dolfinx.mesh.Mesh, material: ElasticMaterial) -> Callable:
     """The 2-D law ``sigma(w) = lambda tr(eps(w)) I + 2 mu eps(w)`` of ``material`` in UFL.
 
-    lambda and mu are :attr:`rkfx.elasticity.ElasticMaterial.lame` (plane strain or plane
+    lambda and mu are :attr:`rkfx.materials.elasticity.ElasticMaterial.lame` (plane strain or plane
     stress), as dolfinx Constants on ``mesh``: forms built with other values share one
     compiled kernel.
 

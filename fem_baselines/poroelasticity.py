@@ -7,7 +7,7 @@ stress positive, pore pressure compressive positive, no gravity):
     alpha div(du/dt) + S dp/dt - div(k grad p) = 0,
 
 with the drained plane-strain law ``sigma'' = lambda tr(eps) I + 2 mu eps`` (E, nu drained;
-``fem_baselines.elasticity.stress_law`` of ``rkfx.elasticity.ElasticMaterial``),
+``fem_baselines.elasticity.stress_law`` of ``rkfx.materials.elasticity.ElasticMaterial``),
 Biot coefficient ``alpha``, storage coefficient ``S = 1/Q`` [1/Pa] (0 = incompressible
 constituents) and mobility ``k`` [m^2/(Pa s)] (permeability / viscosity, i.e. ``k_h/gamma_f``).
 
@@ -20,7 +20,7 @@ monolithically at every step (eqs. 3.38-3.44):
 where ``S`` (only for ``element="q1q1-fpp"``) is the fluid-pressure-projection stabilisation of
 White & Borja (2008) as the seed writes it in eqs. 3.49-3.52,
 ``S = int eps_f (psi - Pi psi)(p - Pi p)`` with ``Pi`` the cell-wise L2 projection onto constants
-and ``eps_f`` from eqs. 3.53-3.54 (``rkfx.poroelasticity.fpp_parameter``, ``h = sqrt(cell
+and ``eps_f`` from eqs. 3.53-3.54 (``rkfx.models.poroelasticity.fpp_parameter``, ``h = sqrt(cell
 area)``). It is assembled exactly as
 ``S = M_eps - C diag(eps_f / |K|) C^T`` (``M_eps`` the eps_f-weighted Q1 mass matrix, ``C`` the
 Q1 x DG0 mixed mass matrix).
@@ -38,9 +38,9 @@ Implementation: dolfinx assembly plugs into the shared solvers of ``rkfx.solvers
 gathered into scipy CSR on every rank in the global numbering ``[u, p]``, the Dirichlet
 conditions are constraint rows with their values at t, and :func:`solve_biot` steps the model
 with ``rkfx.solvers.integrate`` and ``backward_euler()``: one Newton iteration per step and one
-MUMPS factorisation per distinct dt through ``rkfx.linear_solver.Factorizations`` (a new dt
+MUMPS factorisation per distinct dt through ``rkfx.linalg.linear_solver.Factorizations`` (a new dt
 reuses the ordering of the matrix it replaces), with checkpoints and resume. The matrix is
-held whole on every rank and its rows distributed to MUMPS by ``rkfx.petsc``.
+held whole on every rank and its rows distributed to MUMPS by ``rkfx.linalg.petsc``.
 
 Elements: ``"taylor-hood"`` (P2-P1 on triangles, Q2-Q1 on quadrilaterals; inf-sup stable),
 ``"q1q1"`` (equal-order Q1-Q1 on quadrilaterals, P1-P1 on triangles; unstabilised, oscillates
@@ -74,9 +74,9 @@ import dolfinx.mesh
 import ufl
 
 from fem_baselines.elasticity import strain, stress_law
-from rkfx.elasticity import ElasticMaterial
-from rkfx.linear_solver import Factorizations
-from rkfx.poroelasticity import PoroMaterial, fpp_parameter
+from rkfx.materials.elasticity import ElasticMaterial
+from rkfx.linalg.linear_solver import Factorizations
+from rkfx.models.poroelasticity import PoroMaterial, fpp_parameter
 from rkfx.solvers.fields import Field, FieldLayout
 from rkfx.solvers.integrate import integrate
 from rkfx.solvers.model import Constraints
@@ -100,7 +100,7 @@ BoundaryKey = str | Callable[[np.ndarray], np.ndarray]
 
 ELEMENTS = ("taylor-hood", "q1q1", "q1q1-fpp")
 
-#: MUMPS controls beyond ``rkfx.petsc``'s: the AMF ordering (ICNTL(7) = 2) factorises the
+#: MUMPS controls beyond ``rkfx.linalg.petsc``'s: the AMF ordering (ICNTL(7) = 2) factorises the
 #: Mandel Taylor-Hood system 4x faster than the default.
 _MUMPS_ICNTL = {7: 2}
 
@@ -217,7 +217,7 @@ def rectangle_mesh(
 
     Cells are built on rank 0 and distributed by :func:`dolfinx.mesh.create_mesh`. For
     triangles every grid rectangle is split along its diagonal from (x_i, y_j) to
-    (x_i+1, y_j+1) -- the same split everywhere, as in :func:`rkfx.particles.graded`.
+    (x_i+1, y_j+1) -- the same split everywhere, as in :func:`rkfx.geometry.particles.graded`.
     The sides are found by coordinates in :func:`solve_biot` (names ``"left"``, ``"right"``,
     ``"bottom"``, ``"top"``).
 
@@ -389,7 +389,7 @@ class FemBiotModel:
     The unknowns, the same on every rank, are ``[u, p]`` in dolfinx's global dof numbering: u
     interleaved per node of the displacement space V, then p per node of Q; both of time order
     1 (u is quasi-static; its rate enters the storage equation). As in
-    ``rkfx.poroelasticity.BiotModel``, C x' + r(x, t) = 0 with
+    ``rkfx.models.poroelasticity.BiotModel``, C x' + r(x, t) = 0 with
 
         r = [K_uu u - K_up p - F(t), K_H p - Q(t)],   C(dt) = [[0, 0], [K_up^T, K_S + S(dt)]],
 
@@ -701,7 +701,7 @@ def solve_biot(
             house signature.
         initial_u: Initial displacement ``u0(x) -> (2, n)`` with x of shape (2, n); default 0.
         initial_p: Initial pressure ``p0(x) -> (n,)``; default 0.
-        fpp_form: ``"rate"`` (default, as in ``rkfx.poroelasticity``): ``-S`` acting on
+        fpp_form: ``"rate"`` (default, as in ``rkfx.models.poroelasticity``): ``-S`` acting on
             ``P_n+1 - P_n`` (White & Borja's form, stabilising the pressure rate; dimensionally
             consistent with eps_f in 1/Pa); ``"seed"``: ``-dt S`` in the p-p block as eq. 3.51
             is printed, which depends on the unit of time (kept for comparison). Ignored unless

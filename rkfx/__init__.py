@@ -1,29 +1,45 @@
 """rkfx: reproducing kernel particle methods for geomechanics.
 
-The numerical core (this package's top-level modules) needs only numpy, scipy and numba:
+The numerical core needs only numpy, scipy and numba. Its subpackages, in the order of the
+data path (see docs/core.md):
 
-    particles        nodes, spacing, background triangulation, named boundaries
-    gmsh_nodes       particles from gmsh models and .geo files (needs gmsh)
-    nodal_domains    conforming median-dual cells, subcells, boundary segments
-    grid_cells       rectangular Voronoi cells of tensor grids, with slits along cell faces
-    shape_functions  RK shape functions and direct gradients (eqs. 3.17-3.25)
-    quadrature       Gauss, DNI, SCNI and MSCNI rules as sparse rows (eqs. 3.55-3.56)
-    operators        B^T D B w products: stiffness, diffusion, mass, loads
-    boundary         boundary integration and essential conditions
-    elasticity       the 2-D elastic law (plane strain or stress), principal directions
-    elastostatics    plane-strain solver
-    poroelasticity   equal-order u-p Biot solver: NI/SCNI with pressure projection (chapter 3)
-    damage           damage particle method: Mazars strain, damage law, energy regularization (ch. 4)
-    damage_law       Mazars' strain and the softening law compiled, shared by statics and dynamics
-    cracks           pre-existing cracks: diffraction of the kernel supports round crack tips
-    explicit         explicit models: smeared strain B~ (SCNI, MSCNI), lumped mass, stable step
-    crack_tracking   candidate damage particles along crack segments (eq. 4.22)
-    explicit_damage  damage particle method in explicit dynamics: compiled update, runs kept on disk
-    linear_solver    factorized systems through PETSc when installed, else SciPy
-    ranks            serial work under MPI: rank 0 runs it, every rank gets the result
-    warmup           compile the kernels before timing
+    geometry        node sets and their nodal domains
+        particles        nodes, spacing, background triangulation, named boundaries
+        gmsh_nodes       particles from gmsh models and .geo files (needs gmsh)
+        nodal_domains    conforming median-dual cells, subcells, boundary segments
+        grid_cells       rectangular Voronoi cells of tensor grids, with slits along cell faces
+    approximation   the RK approximation
+        kernel           cubic B-spline kernel
+        neighbours       cell-list search of the supports covering a point
+        shape_functions  RK shape functions and direct gradients (eqs. 3.17-3.25)
+        diffraction      pre-existing cracks: diffraction of the kernel supports round crack tips
+        sparse_rows      rows of shape-function values and gradients, and their combinations
+    integration     integration rules as sparse rows
+        quadrature       Gauss, DNI, SCNI and MSCNI rules (eqs. 3.55-3.56)
+        norms            error norms
+    assembly        operators and conditions
+        operators        B^T D B w products: stiffness, diffusion, mass, loads
+        boundary         boundary integration, collocated conditions, Nitsche terms
+        smeared_strain   the smeared strain of explicit SCNI, lumped mass, stable step (eq. 4.31-4.35)
+    materials       constitutive laws
+        elasticity       the 2-D elastic law (plane strain or stress), principal directions
+        damage_law       Mazars' strain and the softening law compiled, shared by statics and dynamics
+    fracture        the damage particle method (chapter 4)
+        damage           damage points: regularization by the cell chord (4.28), trial updates
+        tracking         candidate damage particles along crack segments (eq. 4.22)
+    models          what the steppers advance
+        elastostatics    plane-strain elastostatics
+        poroelasticity   equal-order u-p Biot model: NI/SCNI with pressure projection (chapter 3)
+        damage_bar       the damaging bar under displacement control (chapter 4)
+        damage_dynamics  the damage particle method in explicit dynamics, runs kept on disk
+    solvers         fields, the model protocol, steppers, one Newton, checkpoints
+    linalg          linear solves: factorizations through PETSc (``rkfx.linalg.petsc``) or SciPy
+    conditions      boundary conditions: one vocabulary, values of x and t
+    errors          errors naming the culprit and the fix
+    ranks           serial work under MPI: rank 0 runs it, every rank gets the result
+    warmup          compile the kernels before timing
 
-``rkfx.petsc`` (imported on purpose) hands the sparse operators to PETSc; ``rkfx.cases``
-holds the runnable benchmarks (``python -m rkfx.cases.<name>``).
+``rkfx.linalg.petsc`` (imported on purpose) hands the sparse operators to PETSc;
+``rkfx.cases`` holds the runnable benchmarks (``python -m rkfx.cases.<name>``).
 """
 __version__ = "0.1.0"

@@ -17,80 +17,63 @@ from typing import Any
 
 import numpy as np
 
-from .errors import InputError
+from rkfx.errors import InputError
 
 Boundary = str | Callable[[np.ndarray], np.ndarray]
 Value = float | Sequence[float] | np.ndarray | Callable[..., Any]
 
 
 @dataclass(frozen=True)
-class Displacement:
+class _Vectorial:
+    """A condition on some components of a vector field."""
+
+    boundary: Boundary
+    value: Value = 0.0
+    components: tuple[int, ...] = (0, 1)
+
+    def __post_init__(self):
+        comps = tuple(self.components)
+        if not comps or len(set(comps)) != len(comps) or any(int(k) != k or k < 0 or k > 2 for k in comps):
+            raise InputError(f"{type(self).__name__} on {self.boundary!r}: components {self.components!r} must be "
+                             "distinct indices 0 (x), 1 (y) or 2 (z)")
+
+
+@dataclass(frozen=True)
+class _Scalar:
+    """A condition on a scalar field."""
+
+    boundary: Boundary
+    value: Value = 0.0
+    components: tuple[int, ...] = (0,)
+
+
+class Displacement(_Vectorial):
     """u_c = value for the listed components c on a boundary part [m].
 
     ``value(x, t)`` may return every component ``(m, gdim)``, the prescribed ones
     ``(m, len(components))``, or ``(m,)`` for one component.
     """
 
-    boundary: Boundary
-    value: Value = 0.0
-    components: tuple[int, ...] = (0, 1)
 
-    def __post_init__(self):
-        _check_components(self)
-
-
-@dataclass(frozen=True)
-class Velocity:
+class Velocity(_Vectorial):
     """du_c/dt = value for the listed components c on a boundary part [m/s] (explicit dynamics)."""
 
-    boundary: Boundary
-    value: Value = 0.0
-    components: tuple[int, ...] = (0, 1)
 
-    def __post_init__(self):
-        _check_components(self)
+class Traction(_Vectorial):
+    """Traction t = value(x, t, n) (total traction in u-p models) on a boundary part [Pa]."""
 
 
-@dataclass(frozen=True)
-class Pressure:
+class Pressure(_Scalar):
     """p = value on a boundary part (drained when 0) [Pa]."""
 
-    boundary: Boundary
-    value: Value = 0.0
-    components: tuple[int, ...] = (0,)
 
-
-@dataclass(frozen=True)
-class Traction:
-    """Traction t = value (total traction in u-p models) on a boundary part [Pa]."""
-
-    boundary: Boundary
-    value: Value
-    components: tuple[int, ...] = (0, 1)
-
-    def __post_init__(self):
-        _check_components(self)
-
-
-@dataclass(frozen=True)
-class Flux:
-    """Outward normal fluid flux q . n = value on a boundary part [m/s]."""
-
-    boundary: Boundary
-    value: Value
-    components: tuple[int, ...] = (0,)
+class Flux(_Scalar):
+    """Outward normal fluid flux q . n = value(x, t, n) on a boundary part [m/s]."""
 
 
 Condition = Displacement | Velocity | Pressure | Traction | Flux
 ESSENTIAL = (Displacement, Velocity, Pressure)
 NATURAL = (Traction, Flux)
-
-
-def _check_components(c) -> None:
-    comps = tuple(c.components)
-    if not comps or len(set(comps)) != len(comps) or any(int(k) != k or k < 0 or k > 2 for k in comps):
-        raise InputError(f"{type(c).__name__} on {c.boundary!r}: components {c.components!r} must be distinct "
-                         "indices 0 (x), 1 (y) or 2 (z)")
 
 
 def values(condition: Condition, x: np.ndarray, t: float = 0.0, n: np.ndarray | None = None) -> np.ndarray:

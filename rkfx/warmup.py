@@ -11,16 +11,16 @@ from functools import cache
 def warm_up() -> None:
     import numpy as np
 
-    from .cracks import cracks
-    from .damage import DamageMaterial, cell_geometry, damage_model, initial_state, update
-    from .elasticity import ElasticMaterial
-    from .explicit import lumped_mass, smeared_strain
-    from .explicit_damage import run_damage
-    from .nodal_domains import nodal_domains
-    from .operators import stiffness
-    from .particles import structured
-    from .quadrature import integration_rules, mscni_stabilization, smoothed_gradients
-    from .shape_functions import evaluate, rk_approximation
+    from rkfx.approximation.diffraction import cracks
+    from rkfx.fracture.damage import DamageMaterial, cell_geometry, damage_model, initial_state, update
+    from rkfx.materials.elasticity import ElasticMaterial
+    from rkfx.assembly.smeared_strain import lumped_mass, smeared_strain
+    from rkfx.models.damage_dynamics import run_damage
+    from rkfx.geometry.nodal_domains import nodal_domains
+    from rkfx.assembly.operators import stiffness
+    from rkfx.geometry.particles import structured
+    from rkfx.integration.quadrature import integration_rules, mscni_stabilization, smoothed_gradients
+    from rkfx.approximation.shape_functions import evaluate, rk_approximation
 
     p = structured(1.0, 1.0, 5, 5)
     d = nodal_domains(p)

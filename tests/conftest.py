@@ -6,8 +6,8 @@ import pytest
 
 gmsh = pytest.importorskip("gmsh")
 
-from rkfx.gmsh_nodes import from_gmsh  # noqa: E402
-from rkfx.particles import Particles  # noqa: E402
+from rkfx.geometry.gmsh_nodes import from_gmsh  # noqa: E402
+from rkfx.geometry.particles import Particles  # noqa: E402
 
 
 def _mesh(points, names, h):

@@ -2,13 +2,13 @@
 import numpy as np
 import pytest
 
-from rkfx.boundary import Dirichlet
-from rkfx.elasticity import ElasticMaterial
-from rkfx.elastostatics import solve_plane_strain
+from rkfx.assembly.boundary import Dirichlet
+from rkfx.materials.elasticity import ElasticMaterial
+from rkfx.models.elastostatics import solve_plane_strain
 from rkfx.errors import InputError, SingularMomentMatrix
-from rkfx.particles import from_points, particles, structured
-from rkfx.quadrature import integration_rules
-from rkfx.shape_functions import evaluate, rk_approximation
+from rkfx.geometry.particles import from_points, particles, structured
+from rkfx.integration.quadrature import integration_rules
+from rkfx.approximation.shape_functions import evaluate, rk_approximation
 
 
 def test_support_too_small_names_the_point_and_the_fix():
@@ -82,7 +82,7 @@ def test_singular_system_is_reported_by_the_solver():
     pytest.importorskip("petsc4py")
     import scipy.sparse as sp
 
-    from rkfx.petsc import SolverDiverged, solve
+    from rkfx.linalg.petsc import SolverDiverged, solve
 
     a = sp.csr_matrix(np.array([[1.0, 1.0], [1.0, 1.0]]))
     with pytest.raises(SolverDiverged, match="singular"):

@@ -4,7 +4,7 @@ import json
 import numpy as np
 import pytest
 
-from rkfx import damage as dm
+from rkfx.fracture import damage as dm
 from rkfx.cases import cracked_bar
 from rkfx.errors import InputError
 from verification.cohesive_bar import CohesiveBar
@@ -140,7 +140,7 @@ def test_bad_parameters_exit_2_with_one_line(capsys, setting, name):
 def test_cli_killed_run_resumes_to_the_same_results(tmp_path, monkeypatch):
     """--checkpoint-every / --resume: a run killed inside a later load path, resumed into
     another folder, reports what an uninterrupted run reports (wall times aside)."""
-    from rkfx.damage_bar import LoadCurve
+    from rkfx.models.damage_bar import LoadCurve
 
     args = ["--method", "rkpm", "--set", "nodes=16", "cells=voronoi", "steps=30", "--checkpoint-every", "25"]
     assert cracked_bar.main([*args, "--out", str(tmp_path / "whole")]) == 0

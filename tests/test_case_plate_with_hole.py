@@ -25,7 +25,7 @@ pytest.importorskip("matplotlib")
 
 from rkfx.cases import _cli  # noqa: E402
 from rkfx.cases import plate_with_hole as case  # noqa: E402
-from rkfx.gmsh_nodes import from_geo, from_gmsh  # noqa: E402
+from rkfx.geometry.gmsh_nodes import from_geo, from_gmsh  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 GEO = ROOT / "cases" / "geometry" / "plate_with_hole.geo"

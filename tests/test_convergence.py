@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from conftest import unit_square
-from rkfx.boundary import Dirichlet
-from rkfx.elasticity import ElasticMaterial
-from rkfx.elastostatics import solve_plane_strain
-from rkfx.norms import relative_errors
+from rkfx.assembly.boundary import Dirichlet
+from rkfx.materials.elasticity import ElasticMaterial
+from rkfx.models.elastostatics import solve_plane_strain
+from rkfx.integration.norms import relative_errors
 from verification.manufactured import SineField
 
 MATERIAL = ElasticMaterial(E=1.0, nu=0.3)

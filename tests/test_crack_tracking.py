@@ -2,10 +2,10 @@
 import numpy as np
 import pytest
 
-from rkfx.crack_tracking import tracking
-from rkfx.elasticity import principal_direction
+from rkfx.fracture.tracking import tracking
+from rkfx.materials.elasticity import principal_direction
 from rkfx.errors import InputError
-from rkfx.particles import structured
+from rkfx.geometry.particles import structured
 
 
 @pytest.fixture(scope="module")

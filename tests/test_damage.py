@@ -5,10 +5,10 @@ import pytest
 from scipy.integrate import quad
 from scipy.spatial import Delaunay
 
-from rkfx import damage as dm
+from rkfx.fracture import damage as dm
 from rkfx.errors import InputError
-from rkfx.nodal_domains import nodal_domains
-from rkfx.particles import particles, structured
+from rkfx.geometry.nodal_domains import nodal_domains
+from rkfx.geometry.particles import particles, structured
 
 MAT = dm.DamageMaterial(E=2.0e6, nu=0.0, ft=200.0, GF=1.885)
 

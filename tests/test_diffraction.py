@@ -5,15 +5,15 @@ import numpy as np
 import pytest
 import scipy.sparse.linalg as spla
 
-from rkfx.boundary import Dirichlet, Traction, boundary_quadrature, nitsche_terms, traction_load
-from rkfx.cracks import cracks
-from rkfx.elasticity import ElasticMaterial
+from rkfx.assembly.boundary import Dirichlet, Traction, boundary_quadrature, nitsche_terms, traction_load
+from rkfx.approximation.diffraction import cracks
+from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.errors import InputError
-from rkfx.nodal_domains import nodal_domains
-from rkfx.operators import stiffness
-from rkfx.particles import cut_triangulation, structured
-from rkfx.quadrature import scni, smoothed_gradients
-from rkfx.shape_functions import evaluate, rk_approximation
+from rkfx.geometry.nodal_domains import nodal_domains
+from rkfx.assembly.operators import stiffness
+from rkfx.geometry.particles import cut_triangulation, structured
+from rkfx.integration.quadrature import scni, smoothed_gradients
+from rkfx.approximation.shape_functions import evaluate, rk_approximation
 
 CENTRAL = [[0.25, 0.5], [0.75, 0.5]]  # interior crack with two tips
 EDGE = [[0.0, 0.5], [0.5, 0.5]]  # edge crack: mouth on the left side, tip at (0.5, 0.5)
@@ -230,7 +230,7 @@ def test_edge_crack_opens_under_tension_normal_to_it():
 
 def test_gmsh_mesh_with_an_embedded_crack():
     gmsh = pytest.importorskip("gmsh")
-    from rkfx.gmsh_nodes import from_gmsh
+    from rkfx.geometry.gmsh_nodes import from_gmsh
 
     gmsh.initialize(interruptible=False)
     gmsh.option.setNumber("General.Terminal", 0)

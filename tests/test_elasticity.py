@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from rkfx.elasticity import ElasticMaterial, out_of_plane_ratio, principal_direction
+from rkfx.materials.elasticity import ElasticMaterial, out_of_plane_ratio, principal_direction
 from rkfx.errors import InputError
 
 

@@ -2,16 +2,16 @@
 import numpy as np
 import pytest
 
-from rkfx.boundary import Dirichlet, Traction, boundary_quadrature, traction_load
-from rkfx.elasticity import ElasticMaterial
+from rkfx.assembly.boundary import Dirichlet, Traction, boundary_quadrature, traction_load
+from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.errors import InputError
-from rkfx.explicit import (constraint, dilatational_wave_speed, elastic_force, lumped_mass, max_frequency,
+from rkfx.assembly.smeared_strain import (constraint, dilatational_wave_speed, elastic_force, lumped_mass, max_frequency,
                            smeared_strain, stable_time_step)
-from rkfx.nodal_domains import nodal_domains
-from rkfx.operators import stiffness, strain_matrix
-from rkfx.particles import structured
-from rkfx.quadrature import scni, smoothed_gradients
-from rkfx.shape_functions import evaluate, rk_approximation
+from rkfx.geometry.nodal_domains import nodal_domains
+from rkfx.assembly.operators import stiffness, strain_matrix
+from rkfx.geometry.particles import structured
+from rkfx.integration.quadrature import scni, smoothed_gradients
+from rkfx.approximation.shape_functions import evaluate, rk_approximation
 from rkfx.solvers.central_difference import Constraint, ExplicitDynamics, run_explicit
 from rkfx.solvers.checkpoint import CHECKPOINT
 from rkfx.solvers.checkpoint import load_arrays as load_checkpoint
@@ -39,10 +39,10 @@ def test_smeared_strain_operator_is_the_scni_stiffness():
 def test_mscni_operator_from_subcell_rows_is_the_mscni_stiffness(cells):
     """One product with the subcell rows gives the cell strains, the MSCNI differences and,
     transposed, the force of SCNI plus eq. (3.56), on both kinds of nodal domains."""
-    from rkfx.cracks import cracks
-    from rkfx.grid_cells import grid_domains
-    from rkfx.particles import graded
-    from rkfx.quadrature import mscni_stabilization
+    from rkfx.approximation.diffraction import cracks
+    from rkfx.geometry.grid_cells import grid_domains
+    from rkfx.geometry.particles import graded
+    from rkfx.integration.quadrature import mscni_stabilization
     if cells == "median-dual":
         p = structured(1.0, 0.7, 12, 9)
         rk, dom = rk_approximation(p.x, p.spacing), nodal_domains(p)

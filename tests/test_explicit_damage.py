@@ -3,13 +3,13 @@ code, particle tracking (4.22), the history arrays and their checkpoints."""
 import numpy as np
 import pytest
 
-from rkfx import damage as dm
-from rkfx.crack_tracking import tracking
-from rkfx.explicit import elastic_force, smeared_strain
-from rkfx.explicit_damage import DamageForce, damage_field
-from rkfx.grid_cells import grid_domains
-from rkfx.particles import graded
-from rkfx.shape_functions import rk_approximation
+from rkfx.fracture import damage as dm
+from rkfx.fracture.tracking import tracking
+from rkfx.assembly.smeared_strain import elastic_force, smeared_strain
+from rkfx.models.damage_dynamics import DamageForce, damage_field
+from rkfx.geometry.grid_cells import grid_domains
+from rkfx.geometry.particles import graded
+from rkfx.approximation.shape_functions import rk_approximation
 
 MATERIAL = dm.DamageMaterial(E=1.0e4, nu=0.25, ft=1.0, GF=0.05, plane="strain")
 
@@ -25,7 +25,7 @@ def square():
 
 
 def test_stress_and_damage_match_the_reference_update(square):
-    """Every particle allowed: the compiled kernels give rkfx.damage.update's stress, damage,
+    """Every particle allowed: the compiled kernels give rkfx.fracture.damage.update's stress, damage,
     normals and kappa_c (4.2), (4.6), (4.28) for an inhomogeneous strain history."""
     p, op, model = square
     field = damage_field(model)  # no tracking: all allowed

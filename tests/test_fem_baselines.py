@@ -21,7 +21,7 @@ from fem_baselines.elasticity import (  # noqa: E402
     errors,
     solve_plane_strain,
 )
-from rkfx.elasticity import ElasticMaterial  # noqa: E402
+from rkfx.materials.elasticity import ElasticMaterial  # noqa: E402
 
 E_MMS, NU_MMS = 1.0, 0.3
 SIDES = ("left", "right", "bottom", "top")

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from fem_baselines import crack_band_dynamics as cbd
-from rkfx import damage as dm
+from rkfx.fracture import damage as dm
 from rkfx.errors import InputError
 
 H = 0.005          # coarse mesh: ~500 nodes

@@ -1,14 +1,14 @@
-"""Rectangular grid cells (``rkfx.grid_cells``): exact cells, SCNI/MSCNI patch tests, slits."""
+"""Rectangular grid cells (``rkfx.geometry.grid_cells``): exact cells, SCNI/MSCNI patch tests, slits."""
 import numpy as np
 import pytest
 
-from rkfx import damage as dm
-from rkfx.cracks import cracks
+from rkfx.fracture import damage as dm
+from rkfx.approximation.diffraction import cracks
 from rkfx.errors import InputError
-from rkfx.grid_cells import grid_domains
-from rkfx.particles import geometric_spacing, graded
-from rkfx.quadrature import smoothed_gradients
-from rkfx.shape_functions import rk_approximation
+from rkfx.geometry.grid_cells import grid_domains
+from rkfx.geometry.particles import geometric_spacing, graded
+from rkfx.integration.quadrature import smoothed_gradients
+from rkfx.approximation.shape_functions import rk_approximation
 
 XS = geometric_spacing(2.0, 9, 1.3)
 YS = np.r_[0.0, 0.15, 0.25, 0.5, 0.6, 1.0]
@@ -131,7 +131,7 @@ def test_chord_lengths_of_square_cells():
 
 
 def test_cell_geometry_of_median_dual_domains_needs_the_particles():
-    from rkfx.nodal_domains import nodal_domains
+    from rkfx.geometry.nodal_domains import nodal_domains
 
     p = graded(XS, YS)
     with pytest.raises(InputError, match="pass the Particles"):

@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 
 from conftest import l_shape, unit_square
-from rkfx.nodal_domains import nodal_domains
-from rkfx.particles import graded, geometric_spacing, structured
+from rkfx.geometry.nodal_domains import nodal_domains
+from rkfx.geometry.particles import graded, geometric_spacing, structured
 
 
 @pytest.mark.parametrize("make, area", [(lambda: unit_square(0.08), 1.0), (lambda: l_shape(0.1), 3.0),

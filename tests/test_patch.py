@@ -3,12 +3,12 @@ import numpy as np
 import pytest
 
 from conftest import l_shape, random_points, unit_square
-from rkfx.boundary import Dirichlet, Traction, boundary_quadrature
-from rkfx.elasticity import ElasticMaterial
-from rkfx.elastostatics import solve_plane_strain
-from rkfx.nodal_domains import nodal_domains
-from rkfx.quadrature import integration_rules
-from rkfx.shape_functions import rk_approximation
+from rkfx.assembly.boundary import Dirichlet, Traction, boundary_quadrature
+from rkfx.materials.elasticity import ElasticMaterial
+from rkfx.models.elastostatics import solve_plane_strain
+from rkfx.geometry.nodal_domains import nodal_domains
+from rkfx.integration.quadrature import integration_rules
+from rkfx.approximation.shape_functions import rk_approximation
 from verification.manufactured import LinearField
 
 MATERIAL = ElasticMaterial(E=2.0, nu=0.3)

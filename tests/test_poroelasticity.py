@@ -3,11 +3,11 @@ import numpy as np
 import pytest
 
 from rkfx.errors import InputError
-from rkfx.nodal_domains import nodal_domains
-from rkfx.particles import structured
-from rkfx.poroelasticity import (Displacement, Flux, NodalFields, PoroMaterial, Pressure, biot_operators, fpp_parameter,
+from rkfx.geometry.nodal_domains import nodal_domains
+from rkfx.geometry.particles import structured
+from rkfx.models.poroelasticity import (Displacement, Flux, NodalFields, PoroMaterial, Pressure, biot_operators, fpp_parameter,
                                  solve_biot, time_grid, zero)
-from rkfx.shape_functions import rk_approximation
+from rkfx.approximation.shape_functions import rk_approximation
 
 H = 4.0
 MATERIAL = PoroMaterial(E=1.0e6, nu=0.25, k=1.0e-6)
@@ -78,7 +78,7 @@ def test_bad_input():
 
 def test_a_condition_on_u_y_takes_u_y_from_a_full_vector_value():
     """Value functions may return both components; a u_y condition must use the second."""
-    from rkfx.boundary import collocation
+    from rkfx.assembly.boundary import collocation
 
     p = structured(1.0, 1.0, 4, 4)
     rk = rk_approximation(p.x, p.spacing)

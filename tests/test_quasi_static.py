@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from rkfx import damage as dm
-from rkfx.damage_bar import DamageBarModel, LoadCurve, elastic_limit, strip
+from rkfx.fracture import damage as dm
+from rkfx.models.damage_bar import DamageBarModel, LoadCurve, elastic_limit, strip
 from rkfx.errors import InputError, SolverError
 from rkfx.solvers.checkpoint import load_arrays
 from rkfx.solvers.fields import single

@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 
 from conftest import l_shape, random_points, unit_square
-from rkfx.kernel import cubic_spline_values
-from rkfx.shape_functions import evaluate, rk_approximation
+from rkfx.approximation.kernel import cubic_spline_values
+from rkfx.approximation.shape_functions import evaluate, rk_approximation
 
 
 def test_cubic_spline_kernel_values():

@@ -3,10 +3,10 @@ import numpy as np
 import pytest
 
 from conftest import l_shape
-from rkfx.boundary import Dirichlet
-from rkfx.elasticity import ElasticMaterial
-from rkfx.elastostatics import solve_plane_strain
-from rkfx.norms import relative_errors
+from rkfx.assembly.boundary import Dirichlet
+from rkfx.materials.elasticity import ElasticMaterial
+from rkfx.models.elastostatics import solve_plane_strain
+from rkfx.integration.norms import relative_errors
 from verification.manufactured import SineField
 
 pytestmark = pytest.mark.slow

@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 import scipy.linalg as sl
 
-from rkfx.elasticity import ElasticMaterial
-from rkfx.nodal_domains import nodal_domains
-from rkfx.operators import stiffness
-from rkfx.particles import structured
-from rkfx.quadrature import integration_rules
-from rkfx.shape_functions import rk_approximation
+from rkfx.materials.elasticity import ElasticMaterial
+from rkfx.geometry.nodal_domains import nodal_domains
+from rkfx.assembly.operators import stiffness
+from rkfx.geometry.particles import structured
+from rkfx.integration.quadrature import integration_rules
+from rkfx.approximation.shape_functions import rk_approximation
 
 
 def energy_ratios(rule, n):

@@ -7,7 +7,7 @@
 //
 // Mesh size lc [m] at the outer corners, lc / 3 on the hole (graded in between). Override on
 // the command line (gmsh -setnumber lc 0.2 ...) or cap the sizes with Mesh.MeshSizeMax, which is
-// what rkfx.gmsh_nodes.from_geo(path, mesh_size=h) does: sizes below h (the hole) are kept.
+// what rkfx.geometry.gmsh_nodes.from_geo(path, mesh_size=h) does: sizes below h (the hole) are kept.
 DefineConstant[
   a = {1.0, Name "Parameters/hole radius a [m]"},
   L = {5.0, Name "Parameters/plate half-width L [m]"},

@@ -29,8 +29,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError, SolverError
-from ..warmup import warm_up
+from rkfx.errors import InputError, SolverError
+from rkfx.warmup import warm_up
 
 METHODS = {"rkpm": ("rkpm",), "fem": ("fem",), "both": ("rkpm", "fem")}
 

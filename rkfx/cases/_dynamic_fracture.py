@@ -1,15 +1,15 @@
 """What the dynamic fracture cases share: the particle plate, the run with checkpoints, crack metrics.
 
-A plate is a tensor grid of particles whose rectangular Voronoi cells (``rkfx.grid_cells``)
+A plate is a tensor grid of particles whose rectangular Voronoi cells (``rkfx.geometry.grid_cells``)
 have faces along the pre-existing cracks, so no cell straddles a crack; the RK shape
-functions see the cracks by diffraction (``rkfx.cracks``). The damage particle method
-(``rkfx.explicit_damage``) runs as a ``DamageDynamics`` model on the central-difference
+functions see the cracks by diffraction (``rkfx.approximation.diffraction``). The damage particle method
+(``rkfx.models.damage_dynamics``) runs as a ``DamageDynamics`` model on the central-difference
 stepper (``rkfx.solvers.central_difference``).
 
-``simulate`` runs a model on a plate through ``rkfx.explicit_damage.run_damage``, which
+``simulate`` runs a model on a plate through ``rkfx.models.damage_dynamics.run_damage``, which
 keeps finished work (checkpoints, finished results read back on resume).
 
-Cracks are read off the crack opening w / w_c = D kappa / kappa_c (``rkfx.damage.crack_opening``,
+Cracks are read off the crack opening w / w_c = D kappa / kappa_c (``rkfx.fracture.damage.crack_opening``,
 the fraction of a particle's fracture energy spent), not off D: with the regularized kappa_c
 of a fine model D passes 0.9 at about ten times the threshold strain, where the stress has
 softened by a few per cent only, so a D map shows a wide zone of onset around the cracks.
@@ -23,16 +23,16 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import damage as dm
-from ..crack_tracking import Tracking
-from ..cracks import Cracks, cracks
-from ..explicit import SmearedStrain, lumped_mass, smeared_strain, stable_time_step
-from ..explicit_damage import DamageRun, run_damage
-from ..grid_cells import grid_domains
-from ..nodal_domains import NodalDomains
-from ..particles import Particles, graded
-from ..shape_functions import RKApproximation, rk_approximation
-from ..solvers.central_difference import Constraint
+from rkfx.fracture import damage as dm
+from rkfx.fracture.tracking import Tracking
+from rkfx.approximation.diffraction import Cracks, cracks
+from rkfx.assembly.smeared_strain import SmearedStrain, lumped_mass, smeared_strain, stable_time_step
+from rkfx.models.damage_dynamics import DamageRun, run_damage
+from rkfx.geometry.grid_cells import grid_domains
+from rkfx.geometry.nodal_domains import NodalDomains
+from rkfx.geometry.particles import Particles, graded
+from rkfx.approximation.shape_functions import RKApproximation, rk_approximation
+from rkfx.solvers.central_difference import Constraint
 
 CRACKED = 0.5  # w / w_c from which a particle counts as cracked (half its fracture energy spent)
 
@@ -95,7 +95,7 @@ def simulate(label: str, pl: Plate, model: dm.DamageModel, track: Tracking | Non
              t_end: float, external_force: Callable[[float], np.ndarray] | None = None, samples: int = 200,
              checkpoint_every: int = 0, work_dir: Path | None = None, resume: Path | None = None,
              comm=None) -> DamageRun:
-    """The damage particle method on the plate to ``t_end`` (``rkfx.explicit_damage.run_damage``;
+    """The damage particle method on the plate to ``t_end`` (``rkfx.models.damage_dynamics.run_damage``;
     with an MPI ``comm`` of several ranks, rank 0 runs it)."""
     return run_damage(label, pl.op, pl.mass, pl.dt, model, track, constraints, t_end, external_force, samples,
                       checkpoint_every, work_dir, resume, comm)
@@ -104,7 +104,7 @@ def simulate(label: str, pl: Plate, model: dm.DamageModel, track: Tracking | Non
 def run_studies(results, studies: Sequence[tuple[str, Sequence, Callable]], summary: Callable) -> None:
     """Append to ``results`` the runs ``one(level)`` of each ``(study, levels, one)`` and, after
     each study's runs, ``summary(study, runs)``."""
-    from ._cli import progress  # noqa: PLC0415
+    from rkfx.cases._cli import progress  # noqa: PLC0415
 
     for study, levels, one in studies:
         runs = [one(v) for v in progress(levels, study)]
@@ -187,7 +187,7 @@ def plot_dissipation(results, panels: Sequence[tuple[str, str]], path: Path, tit
         label, order: Line label and sort key of a run.
         scale, unit: Energies are divided by ``scale`` and labelled in ``unit``.
     """
-    from ._cli import pyplot, save  # noqa: PLC0415
+    from rkfx.cases._cli import pyplot, save  # noqa: PLC0415
 
     panels = [(s, t) for s, t in panels if any(r.info.get("study") == s for r in results.runs)]
     if not panels:

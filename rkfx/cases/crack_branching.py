@@ -10,20 +10,20 @@ crack runs from the tip to the right and splits into two major branches that rea
 edge.
 
 Model. As ``rkfx.cases.kalthoff``: a tensor grid of nx x ny particles whose rectangular
-Voronoi cells (``rkfx.grid_cells``) have faces on the crack (nx and ny even, so x = a1 and
+Voronoi cells (``rkfx.geometry.grid_cells``) have faces on the crack (nx and ny even, so x = a1 and
 y = a2 are midlines between particle columns and rows and the crack tip is a cell corner);
 the grid sizes are the even numbers whose spacing is nearest to each requested ``h``. RK shape
 functions with the crack by diffraction (linear basis, cubic B-spline kernel, support 1.75 h:
 the crack mouth at the free edge x = 0 needs more than 1.5 h, see ``kalthoff``), SCNI
-smeared strains with the MSCNI stabilization (weight ``eps_p``; ``rkfx.explicit_damage``
+smeared strains with the MSCNI stabilization (weight ``eps_p``; ``rkfx.models.damage_dynamics``
 explains why dynamics needs it: with plain SCNI the 0.4 mm model grows a central crack
 between the two branches and striped damage), the damage law (4.2) with Mazars' equivalent strain, the regularization
 kappa_c = (G_F / f_t) A_L / V_L (4.28) and particle tracking (4.22) with tol = 0.5; the
 particles within 0.75 h of the crack tip are the seeds. The traction load is the RK boundary
 integral f_I = sum over the top and bottom half-segments of N_I(midpoint) t length
-(``rkfx.boundary.traction_load``, SCNI's one-point rule). Central differences
+(``rkfx.assembly.boundary.traction_load``, SCNI's one-point rule). Central differences
 (``rkfx.solvers.central_difference``) with the lumped mass and dt = 0.5 h / c_d
-(``rkfx.explicit``) to ``t_end`` = 80 microseconds.
+(``rkfx.assembly.smeared_strain``) to ``t_end`` = 80 microseconds.
 
 Studies (``h`` lists nominal spacings [m]):
 
@@ -59,14 +59,14 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import damage as dm
-from ..boundary import Traction, boundary_quadrature, traction_load
-from ..crack_tracking import tracking
-from ..errors import InputError
-from ..explicit_damage import DamageRun
-from . import _cli
-from . import _dynamic_fracture as dyn
-from ._cli import Param, Results, Run
+from rkfx.fracture import damage as dm
+from rkfx.assembly.boundary import Traction, boundary_quadrature, traction_load
+from rkfx.fracture.tracking import tracking
+from rkfx.errors import InputError
+from rkfx.models.damage_dynamics import DamageRun
+from rkfx.cases import _cli
+from rkfx.cases import _dynamic_fracture as dyn
+from rkfx.cases._cli import Param, Results, Run
 
 NAME = "crack_branching"
 LX, LY, A1, A2 = 0.1, 0.04, 0.05, 0.02

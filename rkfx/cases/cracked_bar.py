@@ -9,11 +9,11 @@ A = 10, E = 2e6, G_F = 1.885, f_t = 200, nu = 0; dimensionless units). With kapp
 to 0.999 kappa0 the peak is 0.999 f_t A and the energy to break 0.999 G_F A. The reference is
 ``verification.cohesive_bar``.
 
-Model. A 2-D strip [0, L] x [0, H] with two rows of n nodes (``rkfx.particles.structured``),
+Model. A 2-D strip [0, L] x [0, H] with two rows of n nodes (``rkfx.geometry.particles.structured``),
 H = h = L / (n - 1) (square cells at every n) and thickness A / H, in plane stress with nu = 0
 (plane strain is the same at nu = 0; the bar is uniaxial). Linear RK basis, cubic B-spline
 kernel, support 1.5 h (seed 4.3). Boundary conditions by the collocation (transformation)
-constraints of ``rkfx.boundary.transformation_constraints`` imposed with multipliers:
+constraints of ``rkfx.assembly.boundary.transformation_constraints`` imposed with multipliers:
 u_x = 0 on the left nodes, u_x = u_T on the right nodes, and u_y = 0 on both ends (with nu = 0
 the exact u_y is 0, so these add no reaction; they keep the two halves of the broken bar from
 drifting sideways). The tip force is the sum of the right-hand multipliers.
@@ -23,11 +23,11 @@ gradient rows (4.33), the stress (4.30) and the damage live at the particles, an
 f_int = sum_L B~^T Sigma V_L. The nodal cells are
 
 * ``voronoi`` (default, the seed's choice): the Voronoi cells of the strip, rectangles
-  [x_L - h/2, x_L + h/2] x [0, H/2] (or [H/2, H]), from ``rkfx.grid_cells.grid_domains``:
+  [x_L - h/2, x_L + h/2] x [0, H/2] (or [H/2, H]), from ``rkfx.geometry.grid_cells.grid_domains``:
   each cell cut through its node into quadrants, one smoothing point per quadrant side
   (so a cell's top and bottom sides carry two points each), smoothed by
-  ``rkfx.quadrature.smoothed_gradients``;
-* ``median-dual``: rkfx's own cells (``rkfx.nodal_domains``). On a strip with diagonal-split
+  ``rkfx.integration.quadrature.smoothed_gradients``;
+* ``median-dual``: rkfx's own cells (``rkfx.geometry.nodal_domains``). On a strip with diagonal-split
   quads they are not mirror-symmetric: of the four particles around x = L/2, the two on the
   diagonal of the middle quad own 2/3 of it. All four must fail for the bar to break (they
   form the smallest mechanism), but their strains open in the ratio ~1.32 : 0.68, so with
@@ -38,13 +38,13 @@ f_int = sum_L B~^T Sigma V_L. The nodal cells are
 
 Weak section: particles whose cells touch or cross x = L / 2 (four for even n) get
 kappa0 x ``weak_factor`` (seed: 99.9%). Regularized model: kappa_c = (G_F / f_t) A_L / V_L
-(4.28) with A_L the chord of the cell through x_L along the crack (``rkfx.damage``), the crack
+(4.28) with A_L the chord of the cell through x_L along the crack (``rkfx.fracture.damage``), the crack
 normal taken from the principal stress at initiation, and the material's f_t (the weakening
 only triggers the crack). Unregularized model: one constant kappa_c for every n, equal to
 the regularized value of the 16-node model's weak particles, so that the 16-node models agree
 and the refined ones dissipate less (the band narrows while g_L = f_t kappa_c / 2 stays).
 
-Solution. The discretization and its model (``rkfx.damage_bar``: ``strip``, ``DamageBarModel``)
+Solution. The discretization and its model (``rkfx.models.damage_bar``: ``strip``, ``DamageBarModel``)
 are driven by the quasi-static stepper of the core (``rkfx.solvers.quasi_static.march``), as
 is the crack-band FEM. Displacement control in sub-steps: an elastic step to 98% of
 the first damage threshold, a step just past it (by a tenth of the weakening, so that only the
@@ -66,9 +66,9 @@ bar has no shear; it reports 1.8858e-2 against 1.8850e-2). With one smoothing po
 cell side instead of per quadrant side the shear is ~4.5% and u_T^max = 0.99948 w_c.
 
 Reported per model and n: the force-displacement curve and u_T^max
-(``rkfx.damage.failure_displacement``: the softening branch extrapolated to F = 0; a summary
+(``rkfx.fracture.damage.failure_displacement``: the softening branch extrapolated to F = 0; a summary
 run per model holds ``series["u_T_max"] = {"16": ..., "32": ...}`` and the energies), the crack
-opening w = int D eps dx (4.13), the dissipated energy (``rkfx.damage`` bookkeeping, with the
+opening w = int D eps dx (4.13), the dissipated energy (``rkfx.fracture.damage`` bookkeeping, with the
 work balance int F du - W_elastic as a check), the damage along the bar at u_T = w_c
 (Fig 4.10) and, for Fig 4.11, the axial stress at u_T = u_peak + ``stress_at`` (w_c - u_peak)
 (after damage onset) from (a) a Gauss-integrated solve (8 Gauss points along the axis x 2
@@ -101,8 +101,8 @@ import numpy as np
 
 from verification.cohesive_bar import CohesiveBar
 
-from .. import damage as dm
-from ..damage_bar import (
+from rkfx.fracture import damage as dm
+from rkfx.models.damage_bar import (
     CELLS,
     GAUSS_ACROSS,
     GAUSS_ALONG,
@@ -113,12 +113,12 @@ from ..damage_bar import (
     gauss_strip,
     strip,
 )
-from ..errors import InputError, SolverError
-from ..solvers.checkpoint import CHECKPOINT
-from ..solvers.newton import NewtonOptions
-from ..solvers.quasi_static import QuasiStatic, march
-from . import _cli
-from ._cli import Param, Results, Run
+from rkfx.errors import InputError, SolverError
+from rkfx.solvers.checkpoint import CHECKPOINT
+from rkfx.solvers.newton import NewtonOptions
+from rkfx.solvers.quasi_static import QuasiStatic, march
+from rkfx.cases import _cli
+from rkfx.cases._cli import Param, Results, Run
 
 NAME = "cracked_bar"
 MEDIAN_DUAL_END = 1.6  # median-dual models are followed to 1.6 w_c: they break near 1.47 w_c

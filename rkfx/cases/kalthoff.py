@@ -8,7 +8,7 @@ edges and the crack faces are free. Steel: E = 1.9e11 Pa, nu = 0.3, rho = 8000 k
 f_t = 9.5e8 Pa, G_F = 2e4 N/m. In the experiment the crack leaves the tip at about 70 degrees
 to the initial crack (brittle failure at low impact speed).
 
-Model. A tensor grid of nx x ny particles whose rectangular Voronoi cells (``rkfx.grid_cells``)
+Model. A tensor grid of nx x ny particles whose rectangular Voronoi cells (``rkfx.geometry.grid_cells``)
 have faces exactly on the crack: nx is even and (ny - 1) = 2 mod 4, so x = 0.05 and y = 0.025
 are midlines between particle columns and rows, and the crack tip is a cell corner. The RK
 shape functions (linear basis, cubic B-spline kernel, support 1.75 h) see the crack by the
@@ -16,13 +16,13 @@ diffraction method. The support is wider than the usual 1.5 h because the crack 
 particles across it: a cell-side point next to the crack face at the free edge x = 0 has
 particles in reach only in the first row (collinear) and, at distance sqrt(1.5^2 + 0.25^2) h
 = 1.52 h, in the second; 1.5 h leaves its moment matrix singular. SCNI smeared strains with
-the MSCNI stabilization (weight ``eps_p``; ``rkfx.explicit_damage`` explains why explicit
+the MSCNI stabilization (weight ``eps_p``; ``rkfx.models.damage_dynamics`` explains why explicit
 dynamics needs it), the damage law (4.2) with Mazars' equivalent strain, the regularization
 kappa_c = (G_F / f_t) A_L / V_L (4.28) and particle tracking (4.22) with tol = 0.3 within
-3.5 h, candidates only ahead of their particle (``rkfx.crack_tracking``); the four particles
+3.5 h, candidates only ahead of their particle (``rkfx.fracture.tracking``); the four particles
 around the crack tip are the seeds.
 Central differences (``rkfx.solvers.central_difference``) with the lumped mass and
-dt = 0.5 h / c_d (``rkfx.explicit``); the impact
+dt = 0.5 h / c_d (``rkfx.assembly.smeared_strain``); the impact
 velocity and the roller are collocation conditions imposed by projection. Each run goes to
 ``t_end`` = 80 microseconds.
 
@@ -59,15 +59,15 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import damage as dm
-from ..boundary import Dirichlet
-from ..crack_tracking import tracking
-from ..errors import InputError
-from ..explicit import constraint
-from ..explicit_damage import DamageRun
-from . import _cli
-from . import _dynamic_fracture as dyn
-from ._cli import Param, Results, Run
+from rkfx.fracture import damage as dm
+from rkfx.assembly.boundary import Dirichlet
+from rkfx.fracture.tracking import tracking
+from rkfx.errors import InputError
+from rkfx.assembly.smeared_strain import constraint
+from rkfx.models.damage_dynamics import DamageRun
+from rkfx.cases import _cli
+from rkfx.cases import _dynamic_fracture as dyn
+from rkfx.cases._cli import Param, Results, Run
 
 NAME = "kalthoff"
 SIDE, A1, A2 = 0.1, 0.05, 0.025

@@ -26,7 +26,7 @@ Two studies, both written to results.json and plotted:
 * early — the seed's Fig 3.8: 20 steps of Delta t_D = 0.01 and 0.1, and 2 of 1.0, for every
   RKPM variant and FEM element. Overshoot = max p^h - max p (both over y = 0) in units of p0+.
 
-Methods: RKPM variants ``ni``, ``scni``, ``ni+fpp``, ``scni+fpp`` (``rkfx.poroelasticity``;
+Methods: RKPM variants ``ni``, ``scni``, ``ni+fpp``, ``scni+fpp`` (``rkfx.models.poroelasticity``;
 "scni" is SCNI with the MSCNI subcells, eps_p = 1); FEM ``taylor-hood`` (P2-P1 triangles on
 the same vertices), ``q1q1`` and ``q1q1-fpp`` (bilinear quadrilaterals on the same vertices,
 unstabilized and with the pressure projection) from ``fem_baselines.poroelasticity``.
@@ -50,11 +50,11 @@ import numpy as np
 
 from verification.mandel import Mandel
 
-from ..errors import InputError
-from ..particles import structured
-from ..poroelasticity import VARIANTS, Displacement, PoroMaterial, Pressure, solve_biot, time_grid, zero
-from . import _cli
-from ._cli import Param, Results, Run
+from rkfx.errors import InputError
+from rkfx.geometry.particles import structured
+from rkfx.models.poroelasticity import VARIANTS, Displacement, PoroMaterial, Pressure, solve_biot, time_grid, zero
+from rkfx.cases import _cli
+from rkfx.cases._cli import Param, Results, Run
 
 NAME = "mandel"
 FEM_ELEMENTS = ("taylor-hood", "q1q1", "q1q1-fpp")

@@ -16,11 +16,11 @@ so that the finite plate reproduces the infinite-plate solution exactly
 Discretisation. One gmsh mesh per level, built with the gmsh Python API
 (``cases/geometry/plate_with_hole.geo`` is the same geometry as a .geo file): size h at the
 outer corners, h/3 on the hole, h halved at each level. RKPM uses the mesh's vertices as
-particles and its triangles as the background of the nodal domains (``rkfx.gmsh_nodes``);
+particles and its triangles as the background of the nodal domains (``rkfx.geometry.gmsh_nodes``);
 the FEM baseline (dolfinx P1 / P2, ``fem_baselines.elasticity``) solves on the same triangles.
 
 Reported per method and level: relative L2 error of u and relative H1-seminorm error of u
-(RKPM: ``rkfx.norms``, degree-4 Gauss rule on the triangles, direct gradient of u^h; FEM:
+(RKPM: ``rkfx.integration.norms``, degree-4 Gauss rule on the triangles, direct gradient of u^h; FEM:
 ``fem_baselines.elasticity.errors``), both over the meshed (polygonal) domain; convergence
 rates between levels; sigma_xx at (0, a) from the gradient of u^h (FEM: the stress of the
 corner cell, taken 1 % of the hole's mesh size inside along (1, 1)) and its error relative to
@@ -42,14 +42,14 @@ import numpy as np
 
 from verification.kirsch import Kirsch
 
-from ..boundary import BC_METHODS, Dirichlet, Traction
-from ..elasticity import ElasticMaterial
-from ..elastostatics import solve_plane_strain
-from ..errors import InputError
-from ..norms import relative_errors
-from ..quadrature import RULES
-from . import _cli
-from ._cli import Param, Results, Run
+from rkfx.assembly.boundary import BC_METHODS, Dirichlet, Traction
+from rkfx.materials.elasticity import ElasticMaterial
+from rkfx.models.elastostatics import solve_plane_strain
+from rkfx.errors import InputError
+from rkfx.integration.norms import relative_errors
+from rkfx.integration.quadrature import RULES
+from rkfx.cases import _cli
+from rkfx.cases._cli import Param, Results, Run
 
 NAME = "plate_with_hole"
 HOLE_REFINEMENT = 3.0  # mesh size on the hole = h / HOLE_REFINEMENT
@@ -194,7 +194,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E: float = 1.0e3, nu: float
 
     import gmsh  # noqa: PLC0415
 
-    from ..gmsh_nodes import from_gmsh  # noqa: PLC0415
+    from rkfx.geometry.gmsh_nodes import from_gmsh  # noqa: PLC0415
     if "fem" in methods:
         import ufl  # noqa: PLC0415
 

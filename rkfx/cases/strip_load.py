@@ -47,12 +47,12 @@ from scipy.optimize import brentq
 
 from verification.strip_load import StripLoad
 
-from ..errors import InputError
-from ..particles import graded
-from ..poroelasticity import (VARIANTS, Displacement, PoroMaterial, Pressure, TotalTraction, solve_biot,
+from rkfx.errors import InputError
+from rkfx.geometry.particles import graded
+from rkfx.models.poroelasticity import (VARIANTS, Displacement, PoroMaterial, Pressure, TotalTraction, solve_biot,
                               time_grid, zero)
-from . import _cli
-from ._cli import Param, Results, Run
+from rkfx.cases import _cli
+from rkfx.cases._cli import Param, Results, Run
 
 NAME = "strip_load"
 FEM_ELEMENTS = ("taylor-hood", "q1q1", "q1q1-fpp")

@@ -4,7 +4,7 @@ The stepper advances an explicit model (``ExplicitModel``): the fields of its ``
 (every field of time order 2: d, v = d', a = d''; any sizes and components), a lumped mass
 per unknown, the internal force f_int(d), the external force f_ext(t) and essential
 conditions (``Constraint``). The internal force is any callable of d, so a damage law plugs
-in (``rkfx.explicit_damage.DamageDynamics``): it is called exactly once per step, with the new
+in (``rkfx.models.damage_dynamics.DamageDynamics``): it is called exactly once per step, with the new
 coefficients, and may update history in place, which commits it (an explicit step is never
 retried). ``ExplicitBase`` gives such a model the rest of the protocol of
 ``rkfx.solvers.model`` (mass, capacity, residual, constraints, commit, restore).
@@ -17,7 +17,7 @@ One step n -> n+1 (Belytschko, Liu & Moran, Box 6.1), with a_n = M^-1 (f_ext_n -
     v_{n+1}   = v_{n+1/2} + dt/2 a_{n+1},  projected so that G v_{n+1} = g'(t_{n+1})
 
 Essential conditions are rows G (collocation rows u^h(x_I) = g(t) at boundary nodes, as in
-``rkfx.boundary``, or rows of the identity for nodal unknowns), imposed by projection with
+``rkfx.assembly.boundary``, or rows of the identity for nodal unknowns), imposed by projection with
 the lumped mass: w <- w + M^-1 G^T lambda with (G M^-1 G^T) lambda = target - G w,
 factorized once. A prescribed velocity (e.g. an impact) replaces the half-step target by
 v_bar(t_{n+1/2}). The full-step projection only changes the reported velocity, never the
@@ -29,7 +29,7 @@ work of the constraint forces, the impulses M (v+ - v-) of the two projections o
 over dt (zero for fixed supports). ``balance`` = kinetic + internal - external - constraint
 - initial kinetic stays near zero.
 
-Stability: dt < 2 / omega_max (``rkfx.explicit.stable_time_step``, ``max_frequency``).
+Stability: dt < 2 / omega_max (``rkfx.assembly.smeared_strain.stable_time_step``, ``max_frequency``).
 
 Checkpoints (``checkpoint_every``) hold the whole state at a step boundary through
 ``rkfx.solvers.checkpoint``: d, v, a, the forces, step, time, energies and their history, the
@@ -52,10 +52,10 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..errors import InputError
-from .checkpoint import copy_into, load_arrays, prefixed, save_arrays, unprefixed
-from .fields import FieldLayout, single
-from .model import Constraints, no_constraints
+from rkfx.errors import InputError
+from rkfx.solvers.checkpoint import copy_into, load_arrays, prefixed, save_arrays, unprefixed
+from rkfx.solvers.fields import FieldLayout, single
+from rkfx.solvers.model import Constraints, no_constraints
 
 ENERGIES = ("kinetic", "internal", "external", "constraint")
 MODEL, KEPT = "model__", "kept__"  # checkpoint prefixes of the model's state and the recorder's arrays
@@ -257,7 +257,7 @@ class ExplicitDynamics(ExplicitBase):
         mass: Lumped mass per unknown, shape ``(size,)`` [kg].
         internal_force: f_int(d), shape ``(size,)``; called exactly once per step with the new
             coefficients, so it may update history variables (damage) in place.
-        dt: Time step of ``run_explicit`` [s] (see ``rkfx.explicit.stable_time_step``).
+        dt: Time step of ``run_explicit`` [s] (see ``rkfx.assembly.smeared_strain.stable_time_step``).
         external_force: f_ext(t), shape ``(size,)`` [N]; ``None`` for none.
         constraints: Essential conditions.
         history: Named arrays the force updates in place (the model's ``state()``:
@@ -462,7 +462,7 @@ class CentralDifference:
     """Central differences with a lumped mass (see the module docstring).
 
     Attributes:
-        dt: Time step [s] (``rkfx.explicit.stable_time_step``).
+        dt: Time step [s] (``rkfx.assembly.smeared_strain.stable_time_step``).
     """
 
     dt: float

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from rkfx.errors import InputError
 
 CHECKPOINT = "checkpoint.npz"
 

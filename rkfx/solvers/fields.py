@@ -11,7 +11,7 @@ from functools import cached_property
 
 import numpy as np
 
-from ..errors import InputError
+from rkfx.errors import InputError
 
 
 @dataclass(frozen=True)

@@ -16,11 +16,11 @@ from typing import Protocol
 
 import numpy as np
 
-from ..errors import InputError
-from ..linear_solver import Factorizations
-from .checkpoint import load_arrays, prefixed, save_arrays, unprefixed
-from .model import Model
-from .newmark import Newmark, StepState
+from rkfx.errors import InputError
+from rkfx.linalg.linear_solver import Factorizations
+from rkfx.solvers.checkpoint import load_arrays, prefixed, save_arrays, unprefixed
+from rkfx.solvers.model import Model
+from rkfx.solvers.newmark import Newmark, StepState
 
 
 class Recorder(Protocol):

@@ -23,7 +23,7 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 import scipy.sparse as sp
 
-from .fields import FieldLayout
+from rkfx.solvers.fields import FieldLayout
 
 
 @dataclass(frozen=True)

@@ -29,10 +29,10 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import InputError
-from ..linear_solver import Factorizations
-from .model import Constraints, Model, equation_weights
-from .newton import NewtonOptions, NewtonResult, newton
+from rkfx.errors import InputError
+from rkfx.linalg.linear_solver import Factorizations
+from rkfx.solvers.model import Constraints, Model, equation_weights
+from rkfx.solvers.newton import NewtonOptions, NewtonResult, newton
 
 
 @dataclass

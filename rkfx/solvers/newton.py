@@ -2,7 +2,7 @@
 
 Every stepper hands Newton a ``System`` over its unknowns z (state increments, multipliers,
 load factors): the residual F(z), the Jacobian dF/dz, and its own convergence test. Linear
-solves go through ``rkfx.linear_solver.Factorizations`` (PETSc with the caller's communicator
+solves go through ``rkfx.linalg.linear_solver.Factorizations`` (PETSc with the caller's communicator
 when installed), which also reuses the factorization of a linear system.
 """
 from dataclasses import dataclass, field
@@ -11,8 +11,8 @@ from typing import Protocol
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import InputError, SolverError
-from ..linear_solver import Factorizations
+from rkfx.errors import InputError, SolverError
+from rkfx.linalg.linear_solver import Factorizations
 
 # Why a Newton solve ended.
 CONVERGED = "converged"      # the system's convergence test passed

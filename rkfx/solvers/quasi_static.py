@@ -49,12 +49,12 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import InputError, SolverError
-from ..linear_solver import Factorizations
-from .checkpoint import load_arrays, prefixed, save_arrays, unprefixed
-from .integrate import Recorder  # record(state) after every accepted step (a LoadState), arrays(), restore()
-from .model import Model
-from .newton import NewtonOptions, newton
+from rkfx.errors import InputError, SolverError
+from rkfx.linalg.linear_solver import Factorizations
+from rkfx.solvers.checkpoint import load_arrays, prefixed, save_arrays, unprefixed
+from rkfx.solvers.integrate import Recorder  # record(state) after every accepted step (a LoadState), arrays(), restore()
+from rkfx.solvers.model import Model
+from rkfx.solvers.newton import NewtonOptions, newton
 
 DISPLACEMENT, DISSIPATION = "displacement", "dissipation"
 

@@ -9,8 +9,8 @@ import dolfinx_solver  # noqa: F401
 import numpy as np
 from mpi4py import MPI
 
-from rkfx.particles import structured
-from rkfx.poroelasticity import Displacement, PoroMaterial, Pressure, solve_biot, time_grid, zero
+from rkfx.geometry.particles import structured
+from rkfx.models.poroelasticity import Displacement, PoroMaterial, Pressure, solve_biot, time_grid, zero
 from verification.mandel import Mandel
 
 comm = MPI.COMM_WORLD

@@ -10,10 +10,10 @@ import gmsh
 import numpy as np
 from mpi4py import MPI
 
-from rkfx.boundary import Dirichlet
-from rkfx.elasticity import ElasticMaterial
-from rkfx.elastostatics import solve_plane_strain
-from rkfx.gmsh_nodes import from_gmsh
+from rkfx.assembly.boundary import Dirichlet
+from rkfx.materials.elasticity import ElasticMaterial
+from rkfx.models.elastostatics import solve_plane_strain
+from rkfx.geometry.gmsh_nodes import from_gmsh
 from verification.manufactured import SineField
 
 comm = MPI.COMM_WORLD

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from .particles import Particles
+from rkfx.geometry.particles import Particles
 
 
 @dataclass(frozen=True)
@@ -68,7 +68,7 @@ class NodalDomains:
         boundary: The domain boundary split at edge midpoints.
         subcell_vertices: Counter-clockwise vertices of each subcell, vertex 0 the node, shape
             ``(num_subcells, 4, 2)`` [m], or ``None`` (median-dual cells: see
-            ``rkfx.damage.cell_geometry``).
+            ``rkfx.fracture.damage.cell_geometry``).
     """
 
     area: np.ndarray

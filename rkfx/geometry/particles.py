@@ -2,9 +2,9 @@
 
 A ``Particles`` set is the discretisation every rkfx solver starts from. The triangulation's
 vertices are the nodes; it carries the geometry (boundary edges tagged by name) and defines
-the conforming nodal domains (``rkfx.nodal_domains``). Factories: ``structured`` and
+the conforming nodal domains (``rkfx.geometry.nodal_domains``). Factories: ``structured`` and
 ``graded`` tensor grids, ``from_points`` for a cloud inside a polygon, and
-``rkfx.gmsh_nodes.from_gmsh`` for gmsh geometry.
+``rkfx.geometry.gmsh_nodes.from_gmsh`` for gmsh geometry.
 """
 from dataclasses import dataclass, field
 
@@ -12,7 +12,7 @@ import numba
 import numpy as np
 from scipy.spatial import Delaunay
 
-from .errors import InputError, point_str
+from rkfx.errors import InputError, point_str
 
 
 @dataclass(frozen=True)
@@ -336,12 +336,12 @@ def cut_triangulation(p: Particles, polylines, gap: float | None = None, name: s
 
     Returns:
         ``(particles, cracks)``: the split set (new nodes appended; nodal spacing kept) and
-        the ``rkfx.cracks.Cracks`` to give ``rk_approximation``.
+        the ``rkfx.approximation.diffraction.Cracks`` to give ``rk_approximation``.
 
     Raises:
         InputError: A crack does not run along triangulation edges.
     """
-    from .cracks import cracks as make_cracks  # noqa: PLC0415
+    from rkfx.approximation.diffraction import cracks as make_cracks  # noqa: PLC0415
 
     x, tri, n = p.x, p.triangles, p.num_nodes
     scale = float(np.ptp(x, axis=0).max())

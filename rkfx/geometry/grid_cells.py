@@ -1,11 +1,11 @@
-"""Rectangular nodal domains of a tensor grid: the Voronoi cells of ``rkfx.particles.graded`` nodes.
+"""Rectangular nodal domains of a tensor grid: the Voronoi cells of ``rkfx.geometry.particles.graded`` nodes.
 
 The cell of node (i, j) (node index j nx + i, the order of ``graded``) is the rectangle
 [xm_i, xm_i+1] x [ym_j, ym_j+1] with xm = (xs_0, midpoints of the grid intervals, xs_nx-1) and
 likewise ym, so cells of boundary nodes are half cells and corner cells quarter cells. Each
 cell is cut through its node into (up to) four quadrant subcells, each a rectangle with
 counter-clockwise vertices (x_L, a point on one cell side, the cell corner, a point on the
-other cell side), the convention of the median-dual subcells (``rkfx.nodal_domains``);
+other cell side), the convention of the median-dual subcells (``rkfx.geometry.nodal_domains``);
 quadrants of zero area (beyond the domain boundary) are dropped.
 
 All cell and subcell sides lie on the *refined grid*: the lines through the nodes and the
@@ -16,7 +16,7 @@ of SCNI cancel exactly inside the domain.
 Slits. Cell faces may be declared slits (pre-existing cracks lying on the midlines). A face
 segment on a slit is not shared: each of the two cells gets its own smoothing point, moved off
 the slit by 1e-9 times the grid interval across it towards its own node, so that an RK
-approximation with the same crack (``rkfx.cracks``, diffraction method) evaluates each cell's
+approximation with the same crack (``rkfx.approximation.diffraction``, diffraction method) evaluates each cell's
 side on that cell's side of the crack. The offset perturbs the smoothed gradients of the cells
 along a slit by ~1e-9 relative to the field's gradient; no boundary segments are made on slits
 (their faces are traction-free).
@@ -25,12 +25,12 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .errors import InputError, point_str
-from .nodal_domains import BoundarySegments, NodalDomains
+from rkfx.errors import InputError, point_str
+from rkfx.geometry.nodal_domains import BoundarySegments, NodalDomains
 
 SLIT_OFFSET = 1e-9  # slit smoothing points: distance off the slit / grid interval across it
 _TOL = 1e-9  # coordinate matching tolerance / grid extent
-# Boundary tags of ``rkfx.particles.graded`` (its parts are tagged in this order from 1).
+# Boundary tags of ``rkfx.geometry.particles.graded`` (its parts are tagged in this order from 1).
 TAGS = {"bottom": 1, "right": 2, "top": 3, "left": 4}
 # Quadrants (sx, sy), counter-clockwise around the node.
 _SX = np.array([1, -1, -1, 1])
@@ -60,7 +60,7 @@ def grid_domains(xs: np.ndarray, ys: np.ndarray, slits: Sequence | None = ()) ->
 
     Args:
         xs, ys: Strictly increasing grid coordinates [m]; nodes in the order of
-            ``rkfx.particles.graded(xs, ys)``.
+            ``rkfx.geometry.particles.graded(xs, ys)``.
         slits: Axis-aligned segments ((x0, y0), (x1, y1)) [m] on cell faces: on a midline
             between two grid rows (or columns), from and to grid or mid-grid coordinates.
 

@@ -9,7 +9,7 @@ candidates when they lie close to the segment's line:
 Only *allowed* particles may initiate: the seeds (e.g. the particles at a pre-existing crack
 tip) and the candidates of the damaged ones; the other neighbours of L form its crack
 prevention zone. Since n_L is fixed at initiation, the candidates of L are marked once, when
-L initiates (``rkfx.explicit_damage``). With tracking switched off every particle is allowed,
+L initiates (``rkfx.models.damage_dynamics``). With tracking switched off every particle is allowed,
 which lets spurious damage spread (Fig 4.16).
 
 Growth direction. (4.22) is symmetric: it admits the neighbours on both sides of L along its
@@ -35,8 +35,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import InputError
-from .neighbours import support_neighbours
+from rkfx.errors import InputError
+from rkfx.approximation.neighbours import support_neighbours
 
 
 @dataclass(frozen=True)

@@ -1,14 +1,14 @@
 """A factorized linear system reused over right-hand sides: PETSc when installed, else SciPy.
 
 The core stays importable without PETSc; with ``rkfx[fem]`` installed every solve goes through
-``rkfx.petsc`` (MUMPS LU by default, distributed over the communicator's ranks).
+``rkfx.linalg.petsc`` (MUMPS LU by default, distributed over the communicator's ranks).
 """
 from collections.abc import Mapping
 
 import numpy as np
 import scipy.sparse as sp
 
-from .errors import InputError
+from rkfx.errors import InputError
 
 
 class _ScipyLU:
@@ -33,9 +33,9 @@ class _ScipyLU:
 
 def linear_solver(a: sp.spmatrix, comm=None, solver: str = "mumps", mumps_icntl: Mapping[int, int] | None = None):
     """An object with ``.solve(b)`` and ``.destroy()`` for the matrix ``a`` (``mumps_icntl``:
-    further MUMPS controls, see ``rkfx.petsc.make_ksp``; ignored without PETSc)."""
+    further MUMPS controls, see ``rkfx.linalg.petsc.make_ksp``; ignored without PETSc)."""
     try:
-        from . import petsc  # noqa: PLC0415
+        from rkfx.linalg import petsc  # noqa: PLC0415
     except ImportError:
         if solver != "mumps":
             raise InputError(f"solver {solver!r} needs PETSc: pip install 'rkfx[fem]'") from None
@@ -53,7 +53,7 @@ class Factorizations:
 
     Args:
         comm: Communicator (PETSc when installed).
-        solver: ``mumps``, ``gmres-ilu`` or ``cg-gamg`` (see ``rkfx.petsc``).
+        solver: ``mumps``, ``gmres-ilu`` or ``cg-gamg`` (see ``rkfx.linalg.petsc``).
         keep: Factorizations kept at once (the oldest is freed first).
         mumps_icntl: Further MUMPS controls, e.g. ``{7: 2}`` for the AMF ordering.
         reuse_analysis: A keyed matrix that takes the place of the oldest one when ``keep``

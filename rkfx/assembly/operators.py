@@ -6,9 +6,9 @@ Strains use Voigt order (eps_xx, eps_yy, gamma_xy).
 import numpy as np
 import scipy.sparse as sp
 
-from .errors import InputError
-from .quadrature import Quadrature
-from .sparse_rows import SparseRows
+from rkfx.errors import InputError
+from rkfx.integration.quadrature import Quadrature
+from rkfx.approximation.sparse_rows import SparseRows
 
 
 def strain_matrix(grad: SparseRows) -> sp.csr_matrix:

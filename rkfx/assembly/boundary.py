@@ -17,11 +17,11 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .errors import InputError
-from .nodal_domains import NodalDomains
-from .particles import Particles
-from .shape_functions import RKApproximation, evaluate
-from .sparse_rows import SparseRows
+from rkfx.errors import InputError
+from rkfx.geometry.nodal_domains import NodalDomains
+from rkfx.geometry.particles import Particles
+from rkfx.approximation.shape_functions import RKApproximation, evaluate
+from rkfx.approximation.sparse_rows import SparseRows
 
 BC_METHODS = ("transformation", "nitsche")
 
@@ -178,8 +178,8 @@ def nitsche_terms(p: Particles, bq: BoundaryQuadrature, d: np.ndarray, dirichlet
     """Symmetric Nitsche matrix (2n, 2n) and load (2n,) for the prescribed components."""
     if not penalty > 0:
         raise InputError(f"Nitsche penalty = {penalty!r} must be positive (e.g. 100)")
-    from .elasticity import traction_operator  # noqa: PLC0415
-    from .operators import block_diagonal, strain_matrix  # noqa: PLC0415
+    from rkfx.materials.elasticity import traction_operator  # noqa: PLC0415
+    from rkfx.assembly.operators import block_diagonal, strain_matrix  # noqa: PLC0415
 
     n2 = 2 * p.num_nodes
     k_total = sp.csr_matrix((n2, n2))

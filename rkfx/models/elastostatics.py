@@ -6,16 +6,16 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from .boundary import (BC_METHODS, Dirichlet, Traction, boundary_quadrature, nitsche_terms, traction_load,
+from rkfx.assembly.boundary import (BC_METHODS, Dirichlet, Traction, boundary_quadrature, nitsche_terms, traction_load,
                        transformation_constraints)
-from .elasticity import ElasticMaterial
-from .linear_solver import linear_solver
-from .errors import InputError
-from .nodal_domains import nodal_domains
-from .operators import load_vector, stiffness
-from .particles import Particles
-from .quadrature import integration_rules
-from .shape_functions import RKApproximation, evaluate, rk_approximation
+from rkfx.materials.elasticity import ElasticMaterial
+from rkfx.linalg.linear_solver import linear_solver
+from rkfx.errors import InputError
+from rkfx.geometry.nodal_domains import nodal_domains
+from rkfx.assembly.operators import load_vector, stiffness
+from rkfx.geometry.particles import Particles
+from rkfx.integration.quadrature import integration_rules
+from rkfx.approximation.shape_functions import RKApproximation, evaluate, rk_approximation
 
 
 @dataclass(frozen=True)

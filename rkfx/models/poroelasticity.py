@@ -16,7 +16,7 @@ scni+fpp   SCNI + MSCNI subcells (3.56)-(3.59)     FPP on the same cells (3.60)
 =========  ======================================  ============================
 
 Each step solves J X = R of eqs. (3.50)-(3.51) with the essential conditions imposed at the
-boundary nodes by collocation (the transformation method; see ``rkfx.boundary``), which keeps
+boundary nodes by collocation (the transformation method; see ``rkfx.assembly.boundary``), which keeps
 prescribed pressures exact however small the time step.
 
 The projection term of eq. (3.49) is applied to the pressure *rate*,
@@ -34,19 +34,19 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from .boundary import Collocation, boundary_quadrature, collocation
-from .elasticity import ElasticMaterial
-from .errors import InputError
-from .nodal_domains import NodalDomains, nodal_domains
-from .operators import laplacian, mass, stiffness
-from .particles import Particles
-from .quadrature import Quadrature, dni, mscni_stabilization, scni, smoothed_gradients
-from .shape_functions import RKApproximation, evaluate, rk_approximation
-from .solvers.fields import layout
-from .solvers.integrate import integrate, time_grid  # noqa: F401  (time_grid: part of this module's API)
-from .solvers.model import Constraints, Stateless
-from .solvers.newmark import backward_euler
-from .sparse_rows import SparseRows, combine_rows
+from rkfx.assembly.boundary import Collocation, boundary_quadrature, collocation
+from rkfx.materials.elasticity import ElasticMaterial
+from rkfx.errors import InputError
+from rkfx.geometry.nodal_domains import NodalDomains, nodal_domains
+from rkfx.assembly.operators import laplacian, mass, stiffness
+from rkfx.geometry.particles import Particles
+from rkfx.integration.quadrature import Quadrature, dni, mscni_stabilization, scni, smoothed_gradients
+from rkfx.approximation.shape_functions import RKApproximation, evaluate, rk_approximation
+from rkfx.solvers.fields import layout
+from rkfx.solvers.integrate import integrate, time_grid  # noqa: F401  (time_grid: part of this module's API)
+from rkfx.solvers.model import Constraints, Stateless
+from rkfx.solvers.newmark import backward_euler, step_key
+from rkfx.approximation.sparse_rows import SparseRows, combine_rows
 
 VARIANTS = ("ni", "scni", "ni+fpp", "scni+fpp")
 
@@ -360,7 +360,7 @@ class BiotModel(Stateless):
         return None
 
     def capacity(self, dt: float) -> sp.csr_matrix:
-        key = round(dt, 12)
+        key = step_key(dt)
         if key not in self._capacity:
             if len(self._capacity) > 4:
                 self._capacity.pop(next(iter(self._capacity)))

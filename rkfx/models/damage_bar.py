@@ -9,7 +9,7 @@ u_T and u_y = 0 at the right ones, so G d = u_T g^.
 
 ``DamageBarModel`` is the model of ``rkfx.solvers.quasi_static`` with the tip displacement u_T
 as load factor: r(d) = B^T (V sigma(B d)) with trial damage from the committed state
-(``rkfx.damage.update``), K its consistent tangent, the reaction F = t sum mu_right. What every
+(``rkfx.fracture.damage.update``), K its consistent tangent, the reaction F = t sum mu_right. What every
 quasi-static damage-point model shares (trial and commit, the loading tolerance per control
 mode, the damage growth and the dissipation of a trial) is ``DamageHistory``.
 """
@@ -18,25 +18,25 @@ from dataclasses import dataclass, fields
 import numpy as np
 import scipy.sparse as sp
 
-from . import damage as dm
-from .boundary import Dirichlet, transformation_constraints
-from .errors import InputError
-from .grid_cells import grid_domains
-from .linear_solver import linear_solver
-from .nodal_domains import nodal_domains
-from .operators import block_diagonal, strain_matrix
-from .particles import Particles, structured
-from .quadrature import smoothed_gradients
-from .shape_functions import RKApproximation, evaluate, rk_approximation
-from .solvers.fields import single
-from .solvers.model import Constraints
-from .solvers.quasi_static import DISPLACEMENT, DISSIPATION
-from .sparse_rows import SparseRows
+from rkfx.fracture import damage as dm
+from rkfx.assembly.boundary import Dirichlet, transformation_constraints
+from rkfx.errors import InputError
+from rkfx.geometry.grid_cells import grid_domains
+from rkfx.linalg.linear_solver import linear_solver
+from rkfx.geometry.nodal_domains import nodal_domains
+from rkfx.assembly.operators import block_diagonal, strain_matrix
+from rkfx.geometry.particles import Particles, structured
+from rkfx.integration.quadrature import smoothed_gradients
+from rkfx.approximation.shape_functions import RKApproximation, evaluate, rk_approximation
+from rkfx.solvers.fields import single
+from rkfx.solvers.model import Constraints
+from rkfx.solvers.quasi_static import DISPLACEMENT, DISSIPATION
+from rkfx.approximation.sparse_rows import SparseRows
 
 CELLS = ("voronoi", "median-dual")
 GAUSS_ALONG, GAUSS_ACROSS = 8, 2
 TANGENT_FLOOR = 1e-8  # lower bound of 1 - D in the Newton matrix only (failed points)
-# Loading tolerance of the damage tangent (``rkfx.damage.update``) per control mode: a point
+# Loading tolerance of the damage tangent (``rkfx.fracture.damage.update``) per control mode: a point
 # within it of its threshold softens in the tangent, so that Newton's first prediction of a
 # dissipation-controlled step follows the softening branch.
 LOADING_TOLERANCE = {DISPLACEMENT: 1e-9, DISSIPATION: 1e-3}

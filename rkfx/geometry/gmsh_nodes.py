@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
-from .particles import Particles, particles
+from rkfx.errors import InputError
+from rkfx.geometry.particles import Particles, particles
 
 
 def from_gmsh(model=None, comm=None) -> Particles:

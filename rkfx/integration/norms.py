@@ -3,9 +3,9 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .particles import Particles
-from .quadrature import _TRIANGLE_RULES
-from .shape_functions import RKApproximation, evaluate
+from rkfx.geometry.particles import Particles
+from rkfx.integration.quadrature import _TRIANGLE_RULES
+from rkfx.approximation.shape_functions import RKApproximation, evaluate
 
 
 def gauss_points(p: Particles, degree: int = 4) -> tuple[np.ndarray, np.ndarray]:

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import InputError
+from rkfx.errors import InputError
 
 PLANES = ("strain", "stress")
 

@@ -1,8 +1,8 @@
 """Mazars' equivalent strain (4.6) and the linear-softening damage law (4.2), compiled.
 
 The one implementation of the damage law at a point: the quasi-static update
-(``rkfx.damage.update``), the explicit internal force (``rkfx.explicit_damage.DamageForce``)
-and the array functions of ``rkfx.damage`` (``equivalent_strain``, ``damage``) all evaluate
+(``rkfx.fracture.damage.update``), the explicit internal force (``rkfx.models.damage_dynamics.DamageForce``)
+and the array functions of ``rkfx.fracture.damage`` (``equivalent_strain``, ``damage``) all evaluate
 it through these functions.
 
 * ``principal_strains_at``, ``equivalent_strain_at``, ``damage_at``: the law at one point
@@ -10,12 +10,12 @@ it through these functions.
 * ``strain_kernel`` and ``damage_kernel``: one pass over the damage points each, in
   parallel, writing into arrays the caller owns (no allocation), so that the explicit
   driver can call them at every step. Between the two passes the caller fixes the crack
-  normal and kappa_c of the points that cross their threshold (``rkfx.damage.initiate``).
+  normal and kappa_c of the points that cross their threshold (``rkfx.fracture.damage.initiate``).
   ``strain_kernel_serial`` and ``damage_kernel_serial`` run the same point updates on the
   calling thread, for the quasi-static update.
 
 Voigt strains are (eps_xx, eps_yy, gamma_xy) with the engineering shear; ``nu_zz`` is the
-out-of-plane ratio r of eps_zz = -r (eps_xx + eps_yy) (``rkfx.elasticity.out_of_plane_ratio``:
+out-of-plane ratio r of eps_zz = -r (eps_xx + eps_yy) (``rkfx.materials.elasticity.out_of_plane_ratio``:
 nu / (1 - nu) in plane stress, 0 in plane strain).
 """
 import numba

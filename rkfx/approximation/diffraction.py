@@ -17,7 +17,7 @@ valid and only filters. For a straight crack this is exactly Organ's diffraction
 kinked one it is the shortest path with a single bend at a tip.
 
 Nodes must not lie on a crack (a node there would see both faces): split the node set along
-the crack first (``rkfx.particles.cut_triangulation``), which moves the face copies off the
+the crack first (``rkfx.geometry.particles.cut_triangulation``), which moves the face copies off the
 crack line by a small gap.
 
 Reference: Organ, Fleming, Terry, Belytschko (1996), Continuous meshless approximations for
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from .errors import InputError
+from rkfx.errors import InputError
 
 
 @dataclass(frozen=True)

@@ -8,17 +8,17 @@
   are the differences grad~N_I(x_L) - grad~N_I(x_hat_C) with weights eps_p A_C.
 
 A bilinear form int B^T D B dOmega is then ``sum over rules and points of w B^T D B``, the
-same code for elasticity, Darcy flow and coupling (``rkfx.operators``).
+same code for elasticity, Darcy flow and coupling (``rkfx.assembly.operators``).
 """
 from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import InputError
-from .nodal_domains import NodalDomains
-from .particles import Particles
-from .shape_functions import RKApproximation, evaluate
-from .sparse_rows import SparseRows, combine_rows, difference_rows
+from rkfx.errors import InputError
+from rkfx.geometry.nodal_domains import NodalDomains
+from rkfx.geometry.particles import Particles
+from rkfx.approximation.shape_functions import RKApproximation, evaluate
+from rkfx.approximation.sparse_rows import SparseRows, combine_rows, difference_rows
 
 # Symmetric Gauss rules on the reference triangle: barycentric points and weights (sum 1).
 _TRIANGLE_RULES = {

@@ -14,11 +14,11 @@ central-difference stepper of ``rkfx.solvers.central_difference``:
 5. with the MSCNI terms of eq. (3.56) in the operator (``smeared_strain(..., eps_p)``), the
    subcell strain differences (B~_L - B~_C) d and their force with (1 - D_L) C eps_p A_C;
    steps 1 and 4 then run over the subcell rows, one product each way giving the smeared
-   strains, the differences and the whole force (``rkfx.explicit.Stabilization``).
+   strains, the differences and the whole force (``rkfx.assembly.smeared_strain.Stabilization``).
 
 Steps 2, 4 and 5 are compiled loops over the particles (in parallel): steps 2 and 4 are the
-kernels of ``rkfx.damage_law``, whose point updates the quasi-static ``rkfx.damage.update``
-runs too. Step 3 (``rkfx.damage.initiate``, as in ``update``) touches only the particles that
+kernels of ``rkfx.materials.damage_law``, whose point updates the quasi-static ``rkfx.fracture.damage.update``
+runs too. Step 3 (``rkfx.fracture.damage.initiate``, as in ``update``) touches only the particles that
 initiate in this step.
 
 Why the stabilization. Plain SCNI on a particle grid has zero-energy modes (the
@@ -30,7 +30,7 @@ plain SCNI gives two branches plus a central crack and striped damage; with eps_
 two branches of the seed's Fig 4.18 alone. Damaged particles lose their stabilization with
 their stiffness (factor 1 - D_L), so it never holds a crack closed.
 
-Particle tracking (section 4.2.2, ``rkfx.crack_tracking``): only allowed particles may
+Particle tracking (section 4.2.2, ``rkfx.fracture.tracking``): only allowed particles may
 initiate, and a particle's initiation makes its candidates of (4.22) allowed.
 
 ``DamageDynamics`` is the explicit model (``rkfx.solvers.central_difference.ExplicitModel``):
@@ -54,20 +54,20 @@ from typing import Protocol
 import numba
 import numpy as np
 
-from .crack_tracking import Tracking
-from .damage import DamageModel, crack_opening, dissipation_density, initiate
-from .damage_law import damage_kernel, strain_kernel
-from .errors import InputError
-from .ranks import on_root
-from .solvers.central_difference import CentralDifference, Constraint, ExplicitDynamics, ExplicitState
-from .solvers.checkpoint import copy_into
+from rkfx.fracture.tracking import Tracking
+from rkfx.fracture.damage import DamageModel, crack_opening, dissipation_density, initiate
+from rkfx.materials.damage_law import damage_kernel, strain_kernel
+from rkfx.errors import InputError
+from rkfx.ranks import on_root
+from rkfx.solvers.central_difference import CentralDifference, Constraint, ExplicitDynamics, ExplicitState
+from rkfx.solvers.checkpoint import copy_into
 
 HISTORY = ("time", "dissipated", "damaged", "kinetic", "internal", "external")
 
 
 class StrainOperator(Protocol):
     """Strains at the damage points and the internal force of their stresses: the SCNI smeared
-    strain ``rkfx.explicit.SmearedStrain`` (points = particles), or any operator with this
+    strain ``rkfx.assembly.smeared_strain.SmearedStrain`` (points = particles), or any operator with this
     shape (e.g. the cell strains of linear triangles)."""
 
     @property
@@ -104,7 +104,7 @@ class DamageField:
         allowed: Whether it may initiate (seeds, candidates, damaged), ``(n,)`` bool.
         initiation_time: Time of initiation [s] (NaN before), ``(n,)``.
         parent: The particle whose initiation made this one a candidate (-1: none, e.g. the
-            seeds), ``(n,)`` int64 (``rkfx.crack_tracking``: growth direction).
+            seeds), ``(n,)`` int64 (``rkfx.fracture.tracking``: growth direction).
         clock: Time of the last force evaluation [s], shape ``(1,)`` (starts at -dt, so the
             evaluation of the initial state reads t = 0; checkpointed with the rest).
     """
@@ -127,7 +127,7 @@ class DamageField:
                                               "allowed", "initiation_time", "parent", "clock")}
 
     def dissipated(self, model: DamageModel) -> float:
-        """Energy dissipated so far, sum_L V_L phi(kappa_L) [J per unit thickness] (``rkfx.damage``)."""
+        """Energy dissipated so far, sum_L V_L phi(kappa_L) [J per unit thickness] (``rkfx.fracture.damage``)."""
         i = np.flatnonzero(self.damaged)
         if i.size == 0:
             return 0.0
@@ -275,7 +275,7 @@ class DamageRun:
             external work includes that of the prescribed motions (e.g. an impact velocity).
         damage, kappa, normal, initiation_time: Final damage history per particle.
         opening: Final crack opening over the critical opening, w / w_c per particle
-            (``rkfx.damage.crack_opening``: the fraction of its fracture energy spent).
+            (``rkfx.fracture.damage.crack_opening``: the fraction of its fracture energy spent).
         dissipation: Final dissipated energy per particle, V_L phi(kappa_L) [J/m].
         displacement, velocity: Final coefficients [m] and velocities [m/s], shape ``(2 n,)``.
         steps, dt: Time steps taken and their size [s].

@@ -5,7 +5,7 @@ linear (default) or quadratic monomial basis. Values and direct gradients at any
 points come out as CSR rows over the node index (points x neighbours), computed in parallel
 by compiled kernels. The basis is scaled by a length local to each point so that the moment
 matrix stays well conditioned for any node spacing; the shape functions do not depend on
-that scale. Pre-existing cracks (``rkfx.cracks``) cut the supports by the diffraction
+that scale. Pre-existing cracks (``rkfx.approximation.diffraction``) cut the supports by the diffraction
 method: only the kernel distance changes, so the reproducing conditions still hold.
 """
 from dataclasses import dataclass
@@ -13,11 +13,11 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from .cracks import Cracks, blocked, diffracted_distance, kernel_arrays, near_segments
-from .errors import InputError, SingularMomentMatrix, point_str
-from .kernel import cubic_spline
-from .sparse_rows import SparseRows
-from .neighbours import CHUNK, cell_grid, cell_range, count_covering
+from rkfx.approximation.diffraction import Cracks, blocked, diffracted_distance, kernel_arrays, near_segments
+from rkfx.errors import InputError, SingularMomentMatrix, point_str
+from rkfx.approximation.kernel import cubic_spline
+from rkfx.approximation.sparse_rows import SparseRows
+from rkfx.approximation.neighbours import CHUNK, cell_grid, cell_range, count_covering
 
 # Reciprocal condition number of the scaled moment matrix below which it counts as singular.
 RCOND_MIN = 1e-10
@@ -54,7 +54,7 @@ def rk_approximation(x: np.ndarray, spacing: np.ndarray, support_factor: float =
         support_factor: c > 0; 1.5 is the seed's choice for the linear basis.
         order: 1 (linear) or 2 (quadratic) basis.
         cracks: Pre-existing cracks (diffraction method); nodes must not lie on them
-            (``rkfx.particles.cut_triangulation`` splits a node set along a crack).
+            (``rkfx.geometry.particles.cut_triangulation`` splits a node set along a crack).
     """
     if not np.isfinite(support_factor) or support_factor <= 0:
         raise InputError(f"support_factor = {support_factor!r} must be positive; use e.g. 1.5 "
@@ -111,7 +111,7 @@ def _gather(px, py, x, a, origin, cell, nx, ny, start, order, idx, dxs, dys, phi
     """Nodes covering (px, py) with scaled offsets, kernel values and kernel gradients.
 
     With crack segments near the point, a node whose straight path to the point is cut gets
-    the diffraction distance of ``rkfx.cracks`` (or is dropped when invisible).
+    the diffraction distance of ``rkfx.approximation.diffraction`` (or is dropped when invisible).
     """
     x0, x1, y0, y1 = cell_range(px, py, origin, cell, nx, ny)
     # Segments within one cell (>= every support radius) of the point are all a path of

@@ -4,8 +4,8 @@ Each damage point (an SCNI particle, or any integration point) carries the scala
 the continuum damage model (4.1) driven by its *smeared* strain: for SCNI particles that is
 the cell-smoothed strain of eq. (4.21), ``strain_matrix(smoothed_gradients(...).cell) @ d``.
 Everything here is vectorised over the points. The law at a point, Mazars' strain and D, is
-compiled once in ``rkfx.damage_law``: ``update`` runs the point updates of the explicit force
-of ``rkfx.explicit_damage`` (serially), and ``equivalent_strain`` and ``damage`` are array
+compiled once in ``rkfx.materials.damage_law``: ``update`` runs the point updates of the explicit force
+of ``rkfx.models.damage_dynamics`` (serially), and ``equivalent_strain`` and ``damage`` are array
 forms of the same functions.
 
 * Mazars' equivalent strain (4.6) from the principal strains of Voigt strains
@@ -16,7 +16,7 @@ forms of the same functions.
   A_L the chord of the particle's nodal domain through x_L along the crack (perpendicular to
   the crack normal n_L, which is fixed at damage initiation along the major principal
   direction of the effective stress, ``initiate``). ``chord_lengths`` computes it exactly for
-  the median-dual cells of ``rkfx.nodal_domains``.
+  the median-dual cells of ``rkfx.geometry.nodal_domains``.
 * The smeared stress (4.20)/(4.30), sigma = (1 - D) C eps, its consistent tangent, and the
   dissipated energy.
 * What the damage solvers share (``rkfx.cases.cracked_bar``, ``fem_baselines.crack_band``):
@@ -44,11 +44,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import damage_law as law
-from .elasticity import ElasticMaterial, out_of_plane_ratio, principal_direction
-from .errors import InputError
-from .nodal_domains import NodalDomains
-from .particles import Particles
+from rkfx.materials import damage_law as law
+from rkfx.materials.elasticity import ElasticMaterial, out_of_plane_ratio, principal_direction
+from rkfx.errors import InputError
+from rkfx.geometry.nodal_domains import NodalDomains
+from rkfx.geometry.particles import Particles
 
 
 @dataclass(frozen=True)
@@ -61,7 +61,7 @@ class DamageMaterial:
         ft: Tensile strength f_t [Pa]; the damage threshold is kappa0 = f_t / E.
         GF: Fracture energy G_F [J/m^2 = N/m].
         plane: ``"strain"`` or ``"stress"``: the 2-D idealization of C and of eps_zz in (4.6)
-            (``rkfx.elasticity.ElasticMaterial``).
+            (``rkfx.materials.elasticity.ElasticMaterial``).
     """
 
     E: float
@@ -166,7 +166,7 @@ def damage(kappa: np.ndarray, kappa0: np.ndarray | float, kappa_c: np.ndarray | 
     """Linear-softening damage D(kappa) of (4.2): 0 below kappa0, 1 beyond kappa_c (broadcasts).
 
     Where kappa_c <= kappa0 the law has no softening branch and D jumps to 1 at kappa0
-    (``rkfx.damage_law.damage_at``).
+    (``rkfx.materials.damage_law.damage_at``).
     """
     kappa, kappa0, kappa_c = np.broadcast_arrays(*(np.asarray(a, float) for a in (kappa, kappa0, kappa_c)))
     out = np.empty(kappa.shape)
@@ -235,7 +235,7 @@ class CellGeometry:
         node: Node L of each subcell, shape ``(num_subcells,)``.
         vertices: Counter-clockwise vertices (x_L, m_k, g, m_k-1) of each subcell, shape
             ``(num_subcells, 4, 2)`` [m]: the node, the midpoint of triangle side k, the
-            triangle's centroid and the midpoint of side k-1 (as in ``rkfx.nodal_domains``);
+            triangle's centroid and the midpoint of side k-1 (as in ``rkfx.geometry.nodal_domains``);
             for grid cells the node, a cell-side point, the cell corner, a cell-side point.
         num_nodes: Number of nodes.
     """
@@ -250,7 +250,7 @@ def cell_geometry(p: Particles | NodalDomains) -> CellGeometry:
 
     Args:
         p: ``Particles``: their median-dual cells (subcell 3t + k); or ``NodalDomains``
-            carrying ``subcell_vertices`` (e.g. ``rkfx.grid_cells.grid_domains``): its subcells.
+            carrying ``subcell_vertices`` (e.g. ``rkfx.geometry.grid_cells.grid_domains``): its subcells.
 
     Raises:
         InputError: ``NodalDomains`` without ``subcell_vertices``.
@@ -258,7 +258,7 @@ def cell_geometry(p: Particles | NodalDomains) -> CellGeometry:
     if isinstance(p, NodalDomains):
         if p.subcell_vertices is None:
             raise InputError("these nodal domains carry no subcell_vertices; pass the Particles for "
-                             "median-dual cells, or build the domains with rkfx.grid_cells.grid_domains")
+                             "median-dual cells, or build the domains with rkfx.geometry.grid_cells.grid_domains")
         return CellGeometry(p.subcell_node, p.subcell_vertices, len(p.area))
     tri = p.triangles
     v = p.x[tri]                                # (t, 3, 2)
@@ -479,7 +479,7 @@ def update(model: DamageModel, state: DamageState, strain: np.ndarray, tangent: 
     stress C eps and, in the regularized model, its kappa_c = (G_F / f_t) A_L / V_L (4.28) with
     the material's f_t (the weakening factor only triggers localization) (``initiate``).
     eps_eq, kappa, D and the stress come from the compiled point updates of
-    ``rkfx.damage_law`` that the explicit force runs, with every point allowed to damage.
+    ``rkfx.materials.damage_law`` that the explicit force runs, with every point allowed to damage.
 
     Args:
         model: Fixed point data.

@@ -6,10 +6,10 @@ The mass is lumped, M_I = rho V_L (the nodal-integration mass; ``lumped_mass`` a
 row-sum of the nodally integrated consistent mass). For SCNI the internal force is
 f_int = B~^T Sigma(B~ d) V (eqs. 4.31-4.34) with B~ the smeared strain operator of
 ``smeared_strain``, one sparse product each way per step; a damage law plugs in through the
-stresses (``rkfx.explicit_damage``).
+stresses (``rkfx.models.damage_dynamics``).
 
 Essential conditions are collocation rows G (u^h(x_I) = g(t) at boundary nodes, as in
-``rkfx.boundary``) built by ``constraint``; a prescribed velocity (e.g. an impact) is one
+``rkfx.assembly.boundary``) built by ``constraint``; a prescribed velocity (e.g. an impact) is one
 kind of them. The central-difference stepper that advances these models, imposes the
 conditions by projection and keeps the energies and checkpoints is
 ``rkfx.solvers.central_difference`` (``CentralDifference``; ``run_explicit`` for a problem
@@ -28,16 +28,16 @@ import numba
 import numpy as np
 import scipy.sparse as sp
 
-from .boundary import Dirichlet, transformation_constraints
-from .elasticity import ElasticMaterial
-from .errors import InputError
-from .nodal_domains import NodalDomains, nodal_domains
-from .operators import strain_matrix
-from .particles import Particles
-from .quadrature import smoothed_gradients, subcell_gradients
-from .shape_functions import RKApproximation
-from .solvers.central_difference import Constraint
-from .sparse_rows import SparseRows
+from rkfx.assembly.boundary import Dirichlet, transformation_constraints
+from rkfx.materials.elasticity import ElasticMaterial
+from rkfx.errors import InputError
+from rkfx.geometry.nodal_domains import NodalDomains, nodal_domains
+from rkfx.assembly.operators import strain_matrix
+from rkfx.geometry.particles import Particles
+from rkfx.integration.quadrature import smoothed_gradients, subcell_gradients
+from rkfx.approximation.shape_functions import RKApproximation
+from rkfx.solvers.central_difference import Constraint
+from rkfx.approximation.sparse_rows import SparseRows
 
 
 @numba.njit(parallel=True, cache=True)

@@ -1,6 +1,6 @@
 """PETSc glue: scipy CSR -> distributed ``PETSc.Mat``, vectors, and KSP solves.
 
-Import on purpose (``import rkfx.petsc``); the numerical core never imports PETSc. Every
+Import on purpose (``import rkfx.linalg.petsc``); the numerical core never imports PETSc. Every
 function takes an MPI communicator. Matrices are distributed by contiguous row blocks
 (PETSc's default ownership); each rank inserts only the rows it owns from the CSR data it
 holds, so the same code runs serially and under ``mpiexec -n P``.
@@ -14,7 +14,7 @@ import scipy.sparse as sp
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from .errors import InputError, SolverError
+from rkfx.errors import InputError, SolverError
 
 SOLVERS = ("mumps", "gmres-ilu", "cg-gamg")
 

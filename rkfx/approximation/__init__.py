@@ -1,0 +1,1 @@
+"""RK approximation: kernels, neighbour search, shape functions and gradients, diffraction round cracks; sparse rows."""

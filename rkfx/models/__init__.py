@@ -1,0 +1,1 @@
+"""Models for the steppers: elastostatics, equal-order u-p Biot, the damaging bar, damage dynamics."""
