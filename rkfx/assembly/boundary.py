@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from rkfx.conditions import ESSENTIAL, values
 from rkfx.errors import InputError
 from rkfx.geometry.nodal_domains import NodalDomains
 from rkfx.geometry.particles import Particles
@@ -131,6 +132,9 @@ class Collocation:
         """
         out = []
         for bc, j, c, nodes, ncomp in self.parts:
+            if isinstance(bc, ESSENTIAL):  # rkfx.conditions: values of (x, t), constants
+                out.append(values(bc, x[nodes], *args)[:, j])
+                continue
             v = np.asarray(bc.value(x[nodes], *args), float).reshape(len(nodes), -1)
             col = c if (v.shape[1] == ncomp and ncomp > 1) else (j if v.shape[1] > 1 else 0)
             out.append(v[:, col])

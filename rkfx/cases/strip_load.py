@@ -49,7 +49,7 @@ from verification.strip_load import StripLoad
 
 from rkfx.errors import InputError
 from rkfx.geometry.particles import graded
-from rkfx.models.poroelasticity import (VARIANTS, Displacement, PoroMaterial, Pressure, TotalTraction, solve_biot,
+from rkfx.models.poroelasticity import (VARIANTS, Displacement, PoroMaterial, Pressure, Traction, solve_biot,
                               time_grid, zero)
 from rkfx.cases import _cli
 from rkfx.cases._cli import Param, Results, Run
@@ -121,7 +121,7 @@ def _solve(method, xs, ys, material, q, b, times, outputs, samples, drained, sup
     """Pressure (k, m) and displacement (k, m, 2) at the samples, wall time, unknowns."""
     if method.startswith("rkpm-"):
         p = graded(xs, ys)
-        load = TotalTraction("top", lambda x, t, n: np.column_stack([0 * x[:, 0], -q * (x[:, 0] <= b + 1e-12 * b)]))
+        load = Traction("top", lambda x, t, n: np.column_stack([0 * x[:, 0], -q * (x[:, 0] <= b + 1e-12 * b)]))
         sol = solve_biot(p, material, times, outputs,
                          displacements=[Displacement("bottom", zero), Displacement("left", zero, (0,)),
                                         Displacement("right", zero, (0,))],

@@ -49,7 +49,7 @@ from verification.terzaghi import Terzaghi
 
 from rkfx.errors import InputError
 from rkfx.geometry.particles import structured
-from rkfx.models.poroelasticity import (VARIANTS, Displacement, PoroMaterial, Pressure, TotalTraction, solve_biot,
+from rkfx.models.poroelasticity import (VARIANTS, Displacement, PoroMaterial, Pressure, Traction, solve_biot,
                               time_grid, zero)
 from rkfx.cases import _cli
 from rkfx.cases._cli import Param, Results, Run
@@ -113,7 +113,7 @@ def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_f
                          displacements=[Displacement("bottom", zero), Displacement("left", zero, (0,)),
                                         Displacement("right", zero, (0,))],
                          pressures=[Pressure("top", lambda x, t: np.zeros(len(x)))],
-                         tractions=[TotalTraction("top", lambda x, t, n: np.tile([0.0, -q], (len(x), 1)))],
+                         tractions=[Traction("top", lambda x, t, n: np.tile([0.0, -q], (len(x), 1)))],
                          variant=method[5:], support_factor=support_factor,
                          progress=lambda it: _cli.progress(it, method, len(times) - 1), **io)
         return sol.pressure(samples), sol.wall_time_s, sol.n_dofs

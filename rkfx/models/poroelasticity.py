@@ -36,6 +36,7 @@ import scipy.sparse as sp
 
 from rkfx.assembly.boundary import Collocation, boundary_quadrature, collocation
 from rkfx.materials.elasticity import ElasticMaterial
+from rkfx.conditions import Displacement, Flux, Pressure, Traction, values
 from rkfx.errors import InputError
 from rkfx.geometry.nodal_domains import NodalDomains, nodal_domains
 from rkfx.assembly.operators import laplacian, mass, stiffness
@@ -242,41 +243,8 @@ def biot_operators(p: Particles, rk: RKApproximation, domains: NodalDomains, mat
     return BiotOperators(kuu, kup, ks, kh, rows, weights, nodes, np.sqrt(d.area))
 
 
-# Boundary conditions: functions of position x (m, 2), time t [s] and, for fluxes and
-# tractions, the outward normal n (m, 2).
-@dataclass(frozen=True)
-class Displacement:
-    """u_c = value(x, t)[:, j] for the listed components c on a boundary part [m]."""
-
-    boundary: str
-    value: Callable[[np.ndarray, float], np.ndarray]
-    components: tuple[int, ...] = (0, 1)
-
-
-@dataclass(frozen=True)
-class Pressure:
-    """p = value(x, t) on a boundary part (drained when 0) [Pa]."""
-
-    boundary: str
-    value: Callable[[np.ndarray, float], np.ndarray]
-
-
-@dataclass(frozen=True)
-class TotalTraction:
-    """(sigma'' - alpha p I) n = value(x, t, n) on a boundary part [Pa]."""
-
-    boundary: str
-    value: Callable[[np.ndarray, float, np.ndarray], np.ndarray]
-
-
-@dataclass(frozen=True)
-class Flux:
-    """Outward normal fluid flux q . n = value(x, t, n) on a boundary part [m/s]."""
-
-    boundary: str
-    value: Callable[[np.ndarray, float, np.ndarray], np.ndarray]
-
-
+# Boundary conditions: the core's vocabulary (``rkfx.conditions``); a traction of the u-p
+# model is the total traction (sigma'' - alpha p I) n.
 def zero(x: np.ndarray, t: float, *_) -> np.ndarray:
     """Homogeneous value for any boundary condition."""
     return np.zeros((len(x), 2))
@@ -404,7 +372,7 @@ class _Outputs:
 
 def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_times: Sequence[float],
                displacements: Sequence[Displacement] = (), pressures: Sequence[Pressure] = (),
-               tractions: Sequence[TotalTraction] = (), fluxes: Sequence[Flux] = (),
+               tractions: Sequence[Traction] = (), fluxes: Sequence[Flux] = (),
                variant: str = "scni+fpp", support_factor: float = 1.5,
                gravity: Sequence[float] | None = None, density: float = 0.0, fluid_density: float = 0.0,
                comm=None, solver: str = "mumps", progress: Callable | None = None,
@@ -474,12 +442,12 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
         for tr in tractions:
             sel = bq.select([p.tag(tr.boundary)])
             f += nb[np.flatnonzero(sel)].T @ (bq.weights[sel, None]
-                                               * np.asarray(tr.value(bq.points[sel], t, bq.normals[sel]), float))
+                                               * values(tr, bq.points[sel], t, bq.normals[sel]))
         q = np.zeros(n)
         for fl in fluxes:
             sel = bq.select([p.tag(fl.boundary)])
             q -= nb[np.flatnonzero(sel)].T @ (bq.weights[sel]
-                                               * np.asarray(fl.value(bq.points[sel], t, bq.normals[sel]), float))
+                                               * values(fl, bq.points[sel], t, bq.normals[sel])[:, 0])
         return f.ravel() + f_gravity, q + q_gravity  # F^ext (3.36) and Q^ext (3.37)
 
     model = BiotModel(ops, material, col, p.x, loads)
