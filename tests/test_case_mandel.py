@@ -67,14 +67,15 @@ def test_bad_parameters_exit_2_with_one_line(arg, word, capsys):
 
 
 def test_checkpointed_run_resumes_to_the_same_results(tmp_path):
-    """A run that checkpoints, then an invocation resumed from it: every RKPM run reads its
-    finished state back and the results are identical."""
+    """A run that checkpoints, then an invocation resumed from it: every run (RKPM and FEM)
+    reads its finished state back and the results are identical."""
     out = tmp_path / "first"
-    args = ["--quick", "--method", "rkpm", "--set", "variants=scni+fpp", "early_variants=scni+fpp"]
+    pytest.importorskip("dolfinx_solver")
+    args = ["--quick", "--method", "both", "--set", "variants=scni+fpp", "early_variants=scni+fpp", "fem=q1q1-fpp"]
     assert mandel.main(args + ["--checkpoint-every", "4", "--out", str(out)]) == 0
     assert sorted(p.name for p in (out / "checkpoints").iterdir()) == [
-        "rkpm-scni+fpp-early-dtD0.01", "rkpm-scni+fpp-early-dtD0.1", "rkpm-scni+fpp-early-dtD1",
-        "rkpm-scni+fpp-profiles"]
+        f"{m}-{study}" for m in ("fem-q1q1-fpp", "rkpm-scni+fpp")
+        for study in ("early-dtD0.01", "early-dtD0.1", "early-dtD1", "profiles")]
     again = tmp_path / "again"
     assert mandel.main(args + ["--resume", str(out), "--out", str(again)]) == 0
     a, b = (json.loads((d / "results.json").read_text()) for d in (out, again))

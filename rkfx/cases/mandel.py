@@ -38,7 +38,7 @@ early_variants (list), fem (list), support_factor [-].
     python -m rkfx.cases.mandel [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
         [--checkpoint-every N] [--resume DIR]
 
-With ``--checkpoint-every N`` every RKPM run writes its state every N steps (and at its end) to
+With ``--checkpoint-every N`` every run (RKPM and FEM) writes its state every N steps (and at its end) to
 OUT/checkpoints/; ``--resume DIR`` continues a killed invocation from DIR/checkpoints/, finished
 runs returning their results at once.
 """
@@ -115,7 +115,7 @@ def _rkpm(p, material, exact, times, outputs, variant, support_factor, desc, io)
     return sol, sol.pressure, sol.wall_time_s, sol.n_dofs
 
 
-def _fem(xs, ys, material, exact, times, outputs, element, samples):
+def _fem(xs, ys, material, exact, times, outputs, element, samples, io):
     import dolfinx_solver  # noqa: F401, PLC0415
 
     from fem_baselines import poroelasticity as fb  # noqa: PLC0415
@@ -125,7 +125,7 @@ def _fem(xs, ys, material, exact, times, outputs, element, samples):
            fb.Displacement("top", 1, lambda x, t: np.full(x.shape[1], exact.plate_displacement(t))),
            fb.Pressure("right", 0.0)]
     res = fb.solve_biot(mesh, material.E, material.nu, material.k, material.alpha, material.S, element, bcs,
-                        times, samples, outputs)
+                        times, samples, outputs, **io)
     return res.p, res.wall_time_s, res.n_dofs
 
 
@@ -161,7 +161,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, 
     if "fem" in methods:
         for e in fem:
             def fem_solve(tt, out, key, e=e):
-                pp, wall, dofs = _fem(xs, ys, material, exact, tt, out, e, samples)
+                pp, wall, dofs = _fem(xs, ys, material, exact, tt, out, e, samples, ck.for_run(key))
                 return None, (lambda pts, pp=pp: pp), wall, dofs
             solvers.append((f"fem-{e}", True, True, fem_solve))
     for label, profiles, early, solve in solvers:

@@ -34,7 +34,7 @@ t_D_profile [-], t_D_end [-], depth_history [m], steps_low, variants (list), low
     python -m rkfx.cases.strip_load [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
         [--checkpoint-every N] [--resume DIR]
 
-With ``--checkpoint-every N`` every RKPM run writes its state every N steps (and at its end) to
+With ``--checkpoint-every N`` every run (RKPM and FEM) writes its state every N steps (and at its end) to
 OUT/checkpoints/; ``--resume DIR`` continues a killed invocation from DIR/checkpoints/, finished
 runs returning their results at once.
 """
@@ -142,7 +142,7 @@ def _solve(method, xs, ys, material, q, b, times, outputs, samples, drained, sup
     if drained:
         bcs.append(fb.Pressure("top", 0.0))
     res = fb.solve_biot(mesh, material.E, material.nu, material.k, material.alpha, material.S, element, bcs,
-                        times, samples, outputs)
+                        times, samples, outputs, **io)
     return res.p, res.u, res.wall_time_s, res.n_dofs
 
 

@@ -35,7 +35,7 @@ variants (list), fem (list), refine_ny (list), support_factor [-].
     python -m rkfx.cases.terzaghi [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
         [--checkpoint-every N] [--resume DIR]
 
-With ``--checkpoint-every N`` every RKPM run writes its state every N steps (and at its end) to
+With ``--checkpoint-every N`` every run (RKPM and FEM) writes its state every N steps (and at its end) to
 OUT/checkpoints/; ``--resume DIR`` continues a killed invocation from DIR/checkpoints/, finished
 runs returning their results at once.
 """
@@ -127,7 +127,7 @@ def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_f
     bcs = [fb.Displacement("bottom", 0, 0.0), fb.Displacement("bottom", 1, 0.0), fb.Displacement("left", 0, 0.0),
            fb.Displacement("right", 0, 0.0), fb.Traction("top", np.array([0.0, -q])), fb.Pressure("top", 0.0)]
     res = fb.solve_biot(mesh, material.E, material.nu, material.k, material.alpha, material.S, element, bcs,
-                        times, samples, outputs)
+                        times, samples, outputs, **io)
     return res.p, res.wall_time_s, res.n_dofs
 
 
