@@ -53,12 +53,11 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from rkfx.errors import InputError
-from rkfx.solvers.checkpoint import copy_into, load_arrays, prefixed, save_arrays, unprefixed
+from rkfx.solvers.checkpoint import copy_into, load_arrays, restore_run, save_run
 from rkfx.solvers.fields import FieldLayout, single
 from rkfx.solvers.model import Constraints, no_constraints
 
 ENERGIES = ("kinetic", "internal", "external", "constraint")
-MODEL, KEPT = "model__", "kept__"  # checkpoint prefixes of the model's state and the recorder's arrays
 
 
 # --------------------------------------------------------------------------- kernels
@@ -555,9 +554,7 @@ class CentralDifference:
             s = ExplicitState.from_arrays(ck)
             if s.step > num_steps:
                 raise InputError(f"checkpoint is at step {s.step}, beyond num_steps = {num_steps}")
-            model.restore(unprefixed(ck, MODEL))
-            if recorder is not None:
-                recorder.restore(unprefixed(ck, KEPT))
+            restore_run(ck, model, recorder)
             hist_t[:s.step + 1] = ck["history_time"]
             hist_e[:s.step + 1] = ck["history_energy"]
             resumed = s.step
@@ -582,11 +579,8 @@ class CentralDifference:
             if output_every and (done % output_every == 0 or done == num_steps):
                 record(s)
             if checkpoint_every and done % checkpoint_every == 0:
-                arrays = s.arrays(dt) | {"history_time": hist_t[:done + 1], "history_energy": hist_e[:done + 1]}
-                arrays |= prefixed(model.state(), MODEL)
-                if recorder is not None:
-                    arrays |= prefixed(recorder.arrays(), KEPT)
-                save_arrays(checkpoint_dir, arrays)
+                save_run(checkpoint_dir, s.arrays(dt) | {"history_time": hist_t[:done + 1],
+                                                         "history_energy": hist_e[:done + 1]}, model, recorder)
         wall = _time.perf_counter() - t_wall
         final = ExplicitState(num_steps, num_steps * dt, s.d, s.v, s.a, s.f_int.copy(), s.f_ext.copy(), s.energy)
         return ExplicitResult(final, dt, hist_t, hist_e, snapshots, resumed, wall)

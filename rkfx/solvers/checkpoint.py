@@ -64,3 +64,25 @@ def copy_into(targets: Mapping[str, np.ndarray], arrays: Mapping[str, np.ndarray
         if k not in arrays:
             raise InputError(f"checkpoint has no {what} {k!r}; it holds {sorted(arrays)}")
         arr[...] = arrays[k]
+
+
+MODEL, KEPT = "model__", "kept__"  # prefixes of the model's history and the recorder's arrays
+
+
+def save_run(directory: str | Path, arrays: Mapping[str, np.ndarray], model, recorder=None,
+             comm=None) -> Path:
+    """A stepper's checkpoint: its own ``arrays``, the model's committed ``state()`` and the
+    recorder's ``arrays()`` (when there is one), in one file written atomically."""
+    out = dict(arrays) | prefixed(model.state(), MODEL)
+    if recorder is not None:
+        out |= prefixed(recorder.arrays(), KEPT)
+    return save_arrays(directory, out, comm=comm)
+
+
+def restore_run(arrays: Mapping[str, np.ndarray], model, recorder=None) -> None:
+    """Restore the model's history and the recorder's arrays from the ``load_arrays`` of a
+    ``save_run`` checkpoint (the stepper reads its own arrays)."""
+    model.restore(unprefixed(arrays, MODEL))
+    if recorder is not None:
+        recorder.restore(unprefixed(arrays, KEPT))
+

@@ -18,7 +18,7 @@ import numpy as np
 
 from rkfx.errors import InputError
 from rkfx.linalg.linear_solver import Factorizations
-from rkfx.solvers.checkpoint import load_arrays, prefixed, save_arrays, unprefixed
+from rkfx.solvers.checkpoint import load_arrays, restore_run, prefixed, save_run, unprefixed
 from rkfx.solvers.model import Model
 from rkfx.solvers.newmark import Newmark, StepState
 
@@ -138,9 +138,7 @@ def integrate(stepper: Newmark, model: Model, times: Sequence[float], *, start: 
         if k >= len(t_all) or abs(t_all[k] - s.t) > 1e-12 * max(abs(s.t), 1.0):
             raise InputError(f"checkpoint in {str(resume)!r} is at t = {s.t:.6g} (step {k}), which is not step "
                              f"{k} of these step times; resume with the same times")
-        model.restore(unprefixed(ck, "model__"))
-        if recorder is not None:
-            recorder.restore(unprefixed(ck, "kept__"))
+        restore_run(ck, model, recorder)
         resumed = k
     else:
         s = start if start is not None else stepper.start(model, t0=float(t_all[0]))
@@ -176,10 +174,7 @@ def integrate(stepper: Newmark, model: Model, times: Sequence[float], *, start: 
             if recorder is not None:
                 recorder.record(s)
             if checkpoint_every and (k % checkpoint_every == 0 or k == len(t_all) - 1):
-                arrays = prefixed(s.arrays(), "state__") | prefixed(model.state(), "model__")
-                if recorder is not None:
-                    arrays |= prefixed(recorder.arrays(), "kept__")
-                save_arrays(checkpoint_dir, arrays, comm=comm)
+                save_run(checkpoint_dir, prefixed(s.arrays(), "state__"), model, recorder, comm)
     finally:
         made = solves.count - made
         if own:

@@ -24,7 +24,7 @@ Orders of accuracy (asserted in ``tests/test_steppers.py``): 2 for the trapezoid
 (beta = 1/4, gamma = 1/2), central differences (beta = 0, gamma = 1/2) and Crank-Nicolson
 (theta = 1/2); 1 for backward Euler (theta = 1).
 """
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
@@ -221,14 +221,13 @@ class _Plan:
             raise InputError("an essential condition couples explicit and implicit unknowns; "
                              "constrain each field on its own rows")
         self.any_explicit = bool(self.on_explicit.any())
-        self.G_implicit = self.G  # dx = 1 on implicit unknowns
         self.lumped = _lumped(model.mass(), model.capacity(dt), model.layout.orders, explicit) \
             if self.any_explicit else None
 
     def scaled_rows(self, co: Coefficients) -> sp.csr_matrix:
         """G diag(dx) on value rows, G diag(dv) on rate rows."""
         if not self.any_explicit:
-            return self.G_implicit
+            return self.G  # dx = 1 on every implicit unknown
         return (self.G @ sp.diags(np.where(self.explicit, co.dv, co.dx))).tocsr()
 
 
@@ -257,7 +256,8 @@ class _NewmarkSystem:
         on_explicit = plan.on_explicit
         if on_explicit.any():
             x_t = _project(x_t, self.G[on_explicit], con.g[on_explicit], plan.lumped)
-            rate = con.rate if con.rate is not None else _rate(model, t0, t1, on_explicit)
+            # dg/dt at t1: the model's, or the difference over the step.
+            rate = con.rate if con.rate is not None else (con.g - model.constraints(t0).g) / (t1 - t0)
         self.x_t, self.v_t = x_t, v_t
         self.c0 = self.G @ x_t - con.g
         if on_explicit.any():
@@ -352,11 +352,6 @@ def _project(x: np.ndarray, G: sp.csr_matrix, g: np.ndarray, weight: np.ndarray)
     return x + winv_gt @ np.atleast_1d(lam)
 
 
-def _rate(model: Model, t0: float, t1: float, rows: np.ndarray) -> np.ndarray:
-    """dg/dt at t1 by the difference over the step (models may give ``Constraints.rate``)."""
-    return (model.constraints(t1).g - model.constraints(t0).g) / (t1 - t0)
-
-
 def theta_method(theta: float, **options) -> Newmark:
     """The theta-method for first-order models: 1 backward Euler, 1/2 Crank-Nicolson."""
     return Newmark(theta=theta, **options)
@@ -378,8 +373,3 @@ def trapezoidal(**options) -> Newmark:
 def explicit(**options) -> Newmark:
     """beta = 0, gamma = 1/2, theta = 0: the explicit u-p scheme of eqs. (6.37)-(6.41)."""
     return Newmark(beta=0.0, gamma=0.5, theta=0.0, **options)
-
-
-def with_newton(stepper: Newmark, **options) -> Newmark:
-    """The stepper with other Newton settings."""
-    return replace(stepper, newton=replace(stepper.newton, **options))

@@ -51,7 +51,7 @@ import scipy.sparse as sp
 
 from rkfx.errors import InputError, SolverError
 from rkfx.linalg.linear_solver import Factorizations
-from rkfx.solvers.checkpoint import load_arrays, prefixed, save_arrays, unprefixed
+from rkfx.solvers.checkpoint import load_arrays, restore_run, prefixed, save_run
 from rkfx.solvers.integrate import Recorder  # record(state) after every accepted step (a LoadState), arrays(), restore()
 from rkfx.solvers.model import Model
 from rkfx.solvers.newton import NewtonOptions, newton
@@ -300,9 +300,7 @@ def march(model: Model, targets, stepper: QuasiStatic = QuasiStatic(), *, record
                              "the same parameters")
         x, mu = ck["x"].copy(), ck["mu"].copy()
         cur = _Cursor(**{f.name: type(f.default)(ck["cursor__" + f.name]) for f in fields(_Cursor)})
-        model.restore(unprefixed(ck, "model__"))
-        if recorder is not None:
-            recorder.restore(unprefixed(ck, "kept__"))
+        restore_run(ck, model, recorder)
         resumed = cur.steps
 
     own = solves is None
@@ -316,11 +314,8 @@ def march(model: Model, targets, stepper: QuasiStatic = QuasiStatic(), *, record
 
     def checkpoint():
         cur.wall = wall0 + _time.perf_counter() - t_wall
-        arrays = {"x": x, "mu": mu, "targets": targets} | prefixed(asdict(cur), "cursor__") \
-            | prefixed(model.state(), "model__")
-        if recorder is not None:
-            arrays |= prefixed(recorder.arrays(), "kept__")
-        save_arrays(checkpoint_dir, arrays, comm=comm)
+        save_run(checkpoint_dir, {"x": x, "mu": mu, "targets": targets} | prefixed(asdict(cur), "cursor__"),
+                 model, recorder, comm)
 
     def solve(mode, lam_start, **control):
         """Newton from the committed state; the converged (x, mu, lam) or the failed result."""
