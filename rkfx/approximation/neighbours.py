@@ -69,27 +69,39 @@ def cell_range(px, py, origin, cell, nx, ny):
     return max(cx - 1, 0), min(cx + 2, nx), max(cy - 1, 0), min(cy + 2, ny)
 
 
+@numba.njit(inline="always")
+def covering(px, py, x, a, origin, cell, nx, ny, start, order, out, store):
+    """The nodes J with |p - x_J| < a_J for the point p = (px, py), in cell-list order.
+
+    Writes them to ``out[:k]`` when ``store`` (``out`` may be empty otherwise) and returns k.
+    This is the one traversal of the cell list; counting, filling and the shape-function
+    kernels all visit nodes through it, so they agree on the neighbours and their order.
+    """
+    x0, x1, y0, y1 = cell_range(px, py, origin, cell, nx, ny)
+    k = 0
+    for jy in range(y0, y1):
+        for jx in range(x0, x1):
+            cc = jy * nx + jx
+            for q in range(start[cc], start[cc + 1]):
+                j = order[q]
+                dx = px - x[j, 0]
+                dy = py - x[j, 1]
+                if dx * dx + dy * dy < a[j] * a[j]:
+                    if store:
+                        out[k] = j
+                    k += 1
+    return k
+
+
 @numba.njit(parallel=True, cache=True)
 def count_covering(x, a, points, origin, cell, nx, ny, start, order):
     """Number of nodes J with |p - x_J| < a_J for each point p."""
     m = points.shape[0]
     counts = np.zeros(m, np.int64)
+    none = np.empty(0, np.int32)
     for c in numba.prange((m + CHUNK - 1) // CHUNK):
         for p in range(c * CHUNK, min(m, (c + 1) * CHUNK)):
-            px = points[p, 0]
-            py = points[p, 1]
-            x0, x1, y0, y1 = cell_range(px, py, origin, cell, nx, ny)
-            k = 0
-            for jy in range(y0, y1):
-                for jx in range(x0, x1):
-                    cc = jy * nx + jx
-                    for q in range(start[cc], start[cc + 1]):
-                        j = order[q]
-                        dx = px - x[j, 0]
-                        dy = py - x[j, 1]
-                        if dx * dx + dy * dy < a[j] * a[j]:
-                            k += 1
-            counts[p] = k
+            counts[p] = covering(points[p, 0], points[p, 1], x, a, origin, cell, nx, ny, start, order, none, False)
     return counts
 
 
@@ -98,20 +110,8 @@ def _fill(x, a, points, origin, cell, nx, ny, start, order, indptr, indices):
     m = points.shape[0]
     for c in numba.prange((m + CHUNK - 1) // CHUNK):
         for p in range(c * CHUNK, min(m, (c + 1) * CHUNK)):
-            px = points[p, 0]
-            py = points[p, 1]
-            x0, x1, y0, y1 = cell_range(px, py, origin, cell, nx, ny)
-            k = indptr[p]
-            for jy in range(y0, y1):
-                for jx in range(x0, x1):
-                    cc = jy * nx + jx
-                    for q in range(start[cc], start[cc + 1]):
-                        j = order[q]
-                        dx = px - x[j, 0]
-                        dy = py - x[j, 1]
-                        if dx * dx + dy * dy < a[j] * a[j]:
-                            indices[k] = j
-                            k += 1
+            covering(points[p, 0], points[p, 1], x, a, origin, cell, nx, ny, start, order,
+                     indices[indptr[p]:indptr[p + 1]], True)
 
 
 def support_neighbours(x: np.ndarray, a: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

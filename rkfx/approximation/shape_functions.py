@@ -17,7 +17,7 @@ from rkfx.approximation.diffraction import Cracks, blocked, diffracted_distance,
 from rkfx.errors import InputError, SingularMomentMatrix, point_str
 from rkfx.approximation.kernel import cubic_spline
 from rkfx.approximation.sparse_rows import SparseRows
-from rkfx.approximation.neighbours import CHUNK, cell_grid, cell_range, count_covering
+from rkfx.approximation.neighbours import CHUNK, cell_grid, count_covering, covering
 
 # Reciprocal condition number of the scaled moment matrix below which it counts as singular.
 RCOND_MIN = 1e-10
@@ -112,43 +112,46 @@ def _gather(px, py, x, a, origin, cell, nx, ny, start, order, idx, dxs, dys, phi
 
     With crack segments near the point, a node whose straight path to the point is cut gets
     the diffraction distance of ``rkfx.approximation.diffraction`` (or is dropped when invisible).
+    The buffers hold the Euclidean neighbour count of the point.
     """
-    x0, x1, y0, y1 = cell_range(px, py, origin, cell, nx, ny)
     # Segments within one cell (>= every support radius) of the point are all a path of
     # length < a_J can meet.
     nnear = near_segments(px, py, cell, segments, near) if segments.shape[0] else 0
+    found = covering(px, py, x, a, origin, cell, nx, ny, start, order, idx, True)
     k = 0
-    for jy in range(y0, y1):
-        for jx in range(x0, x1):
-            cc = jy * nx + jx
-            for q in range(start[cc], start[cc + 1]):
-                j = order[q]
-                dx = px - x[j, 0]
-                dy = py - x[j, 1]
-                r2 = dx * dx + dy * dy
-                if r2 < a[j] * a[j]:
-                    r = np.sqrt(r2)
-                    # No crack near the point (the common case) costs one integer test.
-                    if nnear > 0 and blocked(x[j, 0], x[j, 1], px, py, segments, near, nnear, np.nan, np.nan):
-                        dist, ex, ey = diffracted_distance(px, py, x[j, 0], x[j, 1], r, segments, tips,
-                                                           exponent, near, nnear)
-                        if not dist < a[j]:
-                            continue
-                        phi, dphi = cubic_spline(dist / a[j])
-                        g = dphi / a[j]
-                        dphis[k, 0] = g * ex
-                        dphis[k, 1] = g * ey
-                    else:
-                        phi, dphi = cubic_spline(r / a[j])
-                        g = dphi / (r * a[j]) if r > 0.0 else 0.0
-                        dphis[k, 0] = g * dx
-                        dphis[k, 1] = g * dy
-                    idx[k] = j
-                    dxs[k] = dx * inv
-                    dys[k] = dy * inv
-                    phis[k] = phi
-                    k += 1
+    for q in range(found):
+        j = idx[q]
+        dx = px - x[j, 0]
+        dy = py - x[j, 1]
+        r = np.sqrt(dx * dx + dy * dy)
+        # No crack near the point (the common case) costs one integer test.
+        if nnear > 0 and blocked(x[j, 0], x[j, 1], px, py, segments, near, nnear, np.nan, np.nan):
+            dist, ex, ey = diffracted_distance(px, py, x[j, 0], x[j, 1], r, segments, tips,
+                                               exponent, near, nnear)
+            if not dist < a[j]:
+                continue
+            phi, dphi = cubic_spline(dist / a[j])
+            g = dphi / a[j]
+            dphis[k, 0] = g * ex
+            dphis[k, 1] = g * ey
+        else:
+            phi, dphi = cubic_spline(r / a[j])
+            g = dphi / (r * a[j]) if r > 0.0 else 0.0
+            dphis[k, 0] = g * dx
+            dphis[k, 1] = g * dy
+        idx[k] = j  # k <= q: compacted in place
+        dxs[k] = dx * inv
+        dys[k] = dy * inv
+        phis[k] = phi
+        k += 1
     return k
+
+
+@numba.njit(inline="always")
+def _scratch(kmax, num_segments):
+    """Per-work-item buffers of ``_gather``: indices, offsets, kernel values and gradients, segments."""
+    return (np.empty(kmax, np.int64), np.empty(kmax), np.empty(kmax), np.empty(kmax), np.empty((kmax, 2)),
+            np.empty(num_segments, np.int64))
 
 
 @numba.njit(parallel=True, cache=True)
@@ -159,12 +162,7 @@ def _count_cut(x, a, points, origin, cell, nx, ny, start, order, segments, tips,
     for p in range(m):
         kmax = max(kmax, counts[p])
     for c in numba.prange((m + CHUNK - 1) // CHUNK):
-        idx = np.empty(kmax, np.int64)
-        dxs = np.empty(kmax)
-        dys = np.empty(kmax)
-        phis = np.empty(kmax)
-        dphis = np.empty((kmax, 2))
-        near = np.empty(segments.shape[0], np.int64)
+        idx, dxs, dys, phis, dphis, near = _scratch(kmax, segments.shape[0])
         for p in range(c * CHUNK, min(m, (c + 1) * CHUNK)):
             if near_segments(points[p, 0], points[p, 1], cell, segments, near):
                 counts[p] = _gather(points[p, 0], points[p, 1], x, a, origin, cell, nx, ny, start, order,
@@ -172,20 +170,12 @@ def _count_cut(x, a, points, origin, cell, nx, ny, start, order, segments, tips,
 
 
 @numba.njit(parallel=True, cache=True)
-def _rows_linear(x, a, points, scale, origin, cell, nx, ny, start, order, indptr, with_grad,
+def _rows_linear(x, a, points, scale, origin, cell, nx, ny, start, order, indptr, kmax, with_grad,
                  segments, tips, exponent, indices, out, ratio):
     """Linear-basis RK rows in closed form (3 x 3 moment matrix by cofactors)."""
     m = points.shape[0]
-    kmax = 0
-    for p in range(m):
-        kmax = max(kmax, indptr[p + 1] - indptr[p])
     for c in numba.prange((m + CHUNK - 1) // CHUNK):
-        idx = np.empty(kmax, np.int64)
-        dxs = np.empty(kmax)
-        dys = np.empty(kmax)
-        phis = np.empty(kmax)
-        dphis = np.empty((kmax, 2))
-        near = np.empty(segments.shape[0], np.int64)
+        idx, dxs, dys, phis, dphis, near = _scratch(kmax, segments.shape[0])
         for p in range(c * CHUNK, min(m, (c + 1) * CHUNK)):
             inv = 1.0 / scale[p]
             n = _gather(points[p, 0], points[p, 1], x, a, origin, cell, nx, ny, start, order,
@@ -267,26 +257,18 @@ def _basis(u, v, order, h):
 
 
 @numba.njit(parallel=True, cache=True)
-def _rows_generic(x, a, points, scale, origin, cell, nx, ny, start, order, indptr, with_grad,
+def _rows_generic(x, a, points, scale, origin, cell, nx, ny, start, order, indptr, kmax, with_grad,
                   basis_order, segments, tips, exponent, indices, out, ratio):
     """RK rows for any basis order: moment matrix (3.24) solved by Cholesky."""
     nb = 3 if basis_order == 1 else 6
     m = points.shape[0]
-    kmax = 0
-    for p in range(m):
-        kmax = max(kmax, indptr[p + 1] - indptr[p])
     for c in numba.prange((m + CHUNK - 1) // CHUNK):
-        idx = np.empty(kmax, np.int64)
-        dxs = np.empty(kmax)
-        dys = np.empty(kmax)
-        phis = np.empty(kmax)
-        dphis = np.empty((kmax, 2))
+        idx, dxs, dys, phis, dphis, near = _scratch(kmax, segments.shape[0])
         mom = np.empty((nb, nb))
         dmom = np.empty((2, nb, nb))
         fac = np.empty((nb, nb))
         rhs = np.empty((nb, 3))
         h = np.empty((3, nb))
-        near = np.empty(segments.shape[0], np.int64)
         for p in range(c * CHUNK, min(m, (c + 1) * CHUNK)):
             inv = 1.0 / scale[p]
             n = _gather(points[p, 0], points[p, 1], x, a, origin, cell, nx, ny, start, order,
@@ -361,6 +343,7 @@ def evaluate(rk: RKApproximation, points: np.ndarray, gradients: bool = False) -
     g = cell_grid(rk.x, rk.support, points)
     grid = (g.origin, g.cell, *g.shape, g.start, g.order)
     counts = count_covering(rk.x, rk.support, points, *grid)
+    kmax = int(counts.max()) if len(counts) else 0  # Euclidean: the buffers of _gather
     cut = kernel_arrays(rk.cracks)
     if rk.cracks is not None:
         # The Euclidean search over-counts nodes that a crack hides or diffracts out of reach.
@@ -374,10 +357,10 @@ def evaluate(rk: RKApproximation, points: np.ndarray, gradients: bool = False) -
     # Basis scale: any length of the order of the supports; N_I does not depend on it.
     scale = np.full(len(points), float(np.median(rk.support)))
     if rk.order == 1:
-        _rows_linear(rk.x, rk.support, points, scale, *grid, indptr, gradients, *cut,
+        _rows_linear(rk.x, rk.support, points, scale, *grid, indptr, kmax, gradients, *cut,
                      indices, out, ratio)
     else:
-        _rows_generic(rk.x, rk.support, points, scale, *grid, indptr, gradients, rk.order, *cut,
+        _rows_generic(rk.x, rk.support, points, scale, *grid, indptr, kmax, gradients, rk.order, *cut,
                       indices, out, ratio)
     bad = np.flatnonzero(~(ratio >= RCOND_MIN))
     if bad.size:

@@ -58,6 +58,14 @@ class SparseRows:
         return np.stack([self.matrix(k) @ coefficients for k in range(self.num_components)], axis=1)
 
 
+@numba.njit(inline="always")
+def _put(out_idx, out_data, pos, j, src, q, sign):
+    """Entry ``pos`` of the output: column j with the components ``sign * src[q]``."""
+    out_idx[pos] = j
+    for d in range(out_data.shape[1]):
+        out_data[pos, d] = sign * src[q, d]
+
+
 @numba.njit(parallel=True, cache=True)
 def _combine(src_ptr, src_idx, src_val, term_ptr, term_row, term_w, num_cols, nchunks,
              base_ptr, base_idx, base_data, base_row, out_ptr, out_idx, out_data, fill):
@@ -83,9 +91,7 @@ def _combine(src_ptr, src_idx, src_val, term_ptr, term_row, term_w, num_cols, nc
                     stamp[j] = r
                     slot[j] = k
                     if fill:
-                        out_idx[base + k] = j
-                        for d in range(nc):
-                            out_data[base + k, d] = base_data[q, d]
+                        _put(out_idx, out_data, base + k, j, base_data, q, 1.0)
                     k += 1
             for t in range(term_ptr[r], term_ptr[r + 1]):
                 s = term_row[t]
@@ -112,6 +118,17 @@ def _work_items(nrows: int) -> int:
     return max(1, min(nrows, ITEMS_PER_THREAD * numba.get_num_threads()))
 
 
+def _count_then_fill(kernel, args: tuple, nrows: int, nc: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """CSR ``(indptr, indices, data)`` of a two-pass row kernel: count the entries per row, then fill."""
+    out_ptr = np.zeros(nrows + 1, np.int64)
+    kernel(*args, out_ptr, np.empty(0, np.int32), np.empty((0, nc)), False)
+    np.cumsum(out_ptr, out=out_ptr)
+    out_idx = np.empty(out_ptr[-1], np.int32)
+    out_data = np.empty((out_ptr[-1], nc))
+    kernel(*args, out_ptr, out_idx, out_data, True)
+    return out_ptr, out_idx, out_data
+
+
 def combine_rows(source: SparseRows, term_ptr: np.ndarray, term_row: np.ndarray,
                  term_weight: np.ndarray, base: SparseRows | None = None,
                  base_row: np.ndarray | None = None) -> SparseRows:
@@ -135,7 +152,6 @@ def combine_rows(source: SparseRows, term_ptr: np.ndarray, term_row: np.ndarray,
     term_ptr = np.ascontiguousarray(term_ptr, dtype=np.int64)
     term_row = np.ascontiguousarray(term_row, dtype=np.int64)
     nrows = len(term_ptr) - 1
-    out_ptr = np.zeros(nrows + 1, np.int64)
     if base is None:
         base_args = (np.zeros(1, np.int64), np.empty(0, np.int32), np.empty((0, w.shape[1])), np.empty(0, np.int64))
     else:
@@ -143,12 +159,7 @@ def combine_rows(source: SparseRows, term_ptr: np.ndarray, term_row: np.ndarray,
                      np.ascontiguousarray(base_row, dtype=np.int64))
     args = (source.indptr, source.indices, np.ascontiguousarray(source.data[:, 0]), term_ptr, term_row, w,
             source.num_cols, _work_items(nrows), *base_args)
-    _combine(*args, out_ptr, np.empty(0, np.int32), np.empty((0, w.shape[1])), False)
-    np.cumsum(out_ptr, out=out_ptr)
-    out_idx = np.empty(out_ptr[-1], np.int32)
-    out_data = np.empty((out_ptr[-1], w.shape[1]))
-    _combine(*args, out_ptr, out_idx, out_data, True)
-    return SparseRows(out_ptr, out_idx, out_data, source.num_cols)
+    return SparseRows(*_count_then_fill(_combine, args, nrows, w.shape[1]), source.num_cols)
 
 
 @numba.njit(parallel=True, cache=True)
@@ -168,9 +179,7 @@ def _difference(a_ptr, a_idx, a_data, a_row, b_ptr, b_idx, b_data, num_cols, nch
                 j = a_idx[q]
                 marker[j] = base + k
                 if fill:
-                    out_idx[base + k] = j
-                    for d in range(nc):
-                        out_data[base + k, d] = a_data[q, d]
+                    _put(out_idx, out_data, base + k, j, a_data, q, 1.0)
                 k += 1
             for q in range(b_ptr[r], b_ptr[r + 1]):
                 j = b_idx[q]
@@ -179,9 +188,7 @@ def _difference(a_ptr, a_idx, a_data, a_row, b_ptr, b_idx, b_data, num_cols, nch
                     pos = base + k
                     k += 1
                     if fill:
-                        out_idx[pos] = j
-                        for d in range(nc):
-                            out_data[pos, d] = -b_data[q, d]
+                        _put(out_idx, out_data, pos, j, b_data, q, -1.0)
                 elif fill:
                     for d in range(nc):
                         out_data[pos, d] -= b_data[q, d]
@@ -195,13 +202,7 @@ def difference_rows(a: SparseRows, a_row: np.ndarray, b: SparseRows) -> SparseRo
     """Rows ``a[a_row[r]] - b[r]`` (same columns and components), e.g. the MSCNI terms of eq. (3.56)."""
     a_row = np.ascontiguousarray(a_row, dtype=np.int64)
     nrows = len(a_row)
-    out_ptr = np.zeros(nrows + 1, np.int64)
     nc = a.num_components
     args = (a.indptr, a.indices, np.ascontiguousarray(a.data), a_row, b.indptr, b.indices,
             np.ascontiguousarray(b.data), a.num_cols, _work_items(nrows))
-    _difference(*args, out_ptr, np.empty(0, np.int32), np.empty((0, nc)), False)
-    np.cumsum(out_ptr, out=out_ptr)
-    out_idx = np.empty(out_ptr[-1], np.int32)
-    out_data = np.empty((out_ptr[-1], nc))
-    _difference(*args, out_ptr, out_idx, out_data, True)
-    return SparseRows(out_ptr, out_idx, out_data, a.num_cols)
+    return SparseRows(*_count_then_fill(_difference, args, nrows, nc), a.num_cols)
