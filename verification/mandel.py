@@ -53,6 +53,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from verification.moduli import DrainedModuli
+
 _DECAY_EXPONENT = 40.0
 _MIN_ROOTS = 500
 _MAX_ROOTS = 200_000
@@ -90,7 +92,7 @@ def _roots(ratio: float, n: int) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class Mandel:
+class Mandel(DrainedModuli):
     """Mandel's problem for general Biot parameters (S = 0 allowed).
 
     Attributes:
@@ -118,21 +120,6 @@ class Mandel:
             raise ValueError("need alpha > 0 and S >= 0")
 
     # ----- moduli -----
-    @property
-    def G(self) -> float:
-        """Shear modulus [Pa]."""
-        return self.E / (2.0 * (1.0 + self.nu))
-
-    @property
-    def K(self) -> float:
-        """Drained bulk modulus [Pa]."""
-        return self.E / (3.0 * (1.0 - 2.0 * self.nu))
-
-    @property
-    def K_v(self) -> float:
-        """Drained constrained modulus K + 4G/3 [Pa]."""
-        return self.K + 4.0 * self.G / 3.0
-
     @property
     def K_u(self) -> float:
         """Undrained bulk modulus K + alpha^2/S [Pa]; inf for S = 0."""

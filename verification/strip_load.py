@@ -53,6 +53,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import erfc, erfcx
 
+from verification.moduli import DrainedModuli
+
 _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(16)
 
 
@@ -90,7 +92,7 @@ def pressure_kernel_laplace(Xi, Y, s, eta):
 
 
 @dataclass(frozen=True)
-class StripLoad:
+class StripLoad(DrainedModuli):
     """Strip load q on |x| <= b of a drained poroelastic half-plane (alpha = 1, S = 0).
 
     Attributes:
@@ -106,16 +108,6 @@ class StripLoad:
     k: float
     b: float
     q: float
-
-    @property
-    def G(self) -> float:
-        """Shear modulus [Pa]."""
-        return self.E / (2.0 * (1.0 + self.nu))
-
-    @property
-    def K_v(self) -> float:
-        """Constrained modulus lambda + 2G [Pa]."""
-        return self.E * (1.0 - self.nu) / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
 
     @property
     def c(self) -> float:

@@ -47,6 +47,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import erfc
 
+from verification.moduli import DrainedModuli
+
 _FOURIER_EXPONENT = 40.0     # keep terms with M^2 T <= 40
 _FOURIER_MAX_TERMS = 100_000
 _ERFC_ARGUMENT = 6.5         # drop image terms with argument > 6.5
@@ -104,7 +106,7 @@ def _erfc_sum(zeta, T, integral: bool):
 
 
 @dataclass(frozen=True)
-class Terzaghi:
+class Terzaghi(DrainedModuli):
     """One-dimensional consolidation of a column of height H under a step load q.
 
     Attributes:
@@ -124,16 +126,6 @@ class Terzaghi:
     q: float
     alpha: float = 1.0
     S: float = 0.0
-
-    @property
-    def G(self) -> float:
-        """Shear modulus [Pa]."""
-        return self.E / (2.0 * (1.0 + self.nu))
-
-    @property
-    def K_v(self) -> float:
-        """Constrained modulus K + 4G/3 = E (1-nu) / ((1+nu)(1-2nu)) [Pa]."""
-        return self.E * (1.0 - self.nu) / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
 
     @property
     def p0(self) -> float:
