@@ -80,7 +80,8 @@ from rkfx.models.poroelasticity import PoroMaterial, fpp_parameter
 from rkfx.solvers.fields import Field, FieldLayout
 from rkfx.solvers.integrate import integrate
 from rkfx.solvers.model import Constraints
-from rkfx.solvers.newmark import StepState, backward_euler, step_key
+from rkfx.solvers.model import step_key
+from rkfx.solvers.newmark import StepState, backward_euler
 
 __all__ = [
     "BiotResult",

@@ -2,6 +2,9 @@
 
 The core stays importable without PETSc; with ``rkfx[fem]`` installed every solve goes through
 ``rkfx.linalg.petsc`` (MUMPS LU by default, distributed over the communicator's ranks).
+``solver="serial"`` factorizes a small system that every rank holds whole (the projection onto
+the essential conditions, k x k for k constrained values) by SuperLU on each rank, with no
+communication in its solves.
 """
 from collections.abc import Mapping
 
@@ -27,13 +30,21 @@ class _ScipyLU:
     def matches(self, a: sp.spmatrix) -> bool:
         return False  # SuperLU has no numerical refactorization to reuse
 
+    def pivot_ratio(self) -> float:
+        """Smallest over largest |pivot| of the factorization (0 for a numerically singular matrix)."""
+        pivots = np.abs(self._lu.U.diagonal())
+        return float(pivots.min() / pivots.max()) if pivots.size and pivots.max() > 0 else 0.0
+
     def destroy(self) -> None:
         pass
 
 
 def linear_solver(a: sp.spmatrix, comm=None, solver: str = "mumps", mumps_icntl: Mapping[int, int] | None = None):
     """An object with ``.solve(b)`` and ``.destroy()`` for the matrix ``a`` (``mumps_icntl``:
-    further MUMPS controls, see ``rkfx.linalg.petsc.make_ksp``; ignored without PETSc)."""
+    further MUMPS controls, see ``rkfx.linalg.petsc.make_ksp``; ignored without PETSc).
+    ``solver="serial"``: SuperLU on each rank, for a small system every rank holds whole."""
+    if solver == "serial":
+        return _ScipyLU(a)
     try:
         from rkfx.linalg import petsc  # noqa: PLC0415
     except ImportError:

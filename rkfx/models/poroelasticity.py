@@ -45,8 +45,8 @@ from rkfx.integration.quadrature import Quadrature, dni, mscni_stabilization, sc
 from rkfx.approximation.shape_functions import RKApproximation, evaluate, rk_approximation
 from rkfx.solvers.fields import layout
 from rkfx.solvers.integrate import integrate, time_grid  # noqa: F401  (time_grid: part of this module's API)
-from rkfx.solvers.model import Constraints, Stateless
-from rkfx.solvers.newmark import backward_euler, step_key
+from rkfx.solvers.model import Constraints, PerStepSize, Stateless
+from rkfx.solvers.newmark import backward_euler
 from rkfx.approximation.sparse_rows import SparseRows, combine_rows
 
 VARIANTS = ("ni", "scni", "ni+fpp", "scni+fpp")
@@ -309,7 +309,7 @@ class BiotModel(Stateless):
         self.nodes = nodes
         o = operators
         self._K = sp.bmat([[o.Kuu, -o.Kup], [None, o.Kh]], format="csr")
-        self._capacity: dict = {}
+        self._per_step = PerStepSize(keep=5)
         self._n = n
 
     def storage(self, dt: float) -> sp.csr_matrix:
@@ -328,14 +328,9 @@ class BiotModel(Stateless):
         return None
 
     def capacity(self, dt: float) -> sp.csr_matrix:
-        key = step_key(dt)
-        if key not in self._capacity:
-            if len(self._capacity) > 4:
-                self._capacity.pop(next(iter(self._capacity)))
-            n = self._n
-            self._capacity[key] = sp.bmat([[sp.csr_matrix((2 * n, 2 * n)), None],
-                                           [self.operators.Kup.T, self.storage(dt)]], format="csr")
-        return self._capacity[key]
+        n = self._n
+        return self._per_step.get("capacity", dt, lambda dt: sp.bmat(
+            [[sp.csr_matrix((2 * n, 2 * n)), None], [self.operators.Kup.T, self.storage(dt)]], format="csr"))
 
     def constraints(self, t: float) -> Constraints:
         return Constraints(self.collocation.G, self.collocation.values(self.nodes, t))

@@ -50,9 +50,9 @@ from typing import Protocol, runtime_checkable
 import numba
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from rkfx.errors import InputError
+from rkfx.linalg.linear_solver import linear_solver
 from rkfx.solvers.checkpoint import copy_into, load_arrays, restore_run, save_run
 from rkfx.solvers.fields import FieldLayout, single
 from rkfx.solvers.model import Constraints, no_constraints
@@ -380,12 +380,10 @@ class _Projection:
             raise InputError(f"constraint rows have {self.G.shape[1]} columns for {len(mass)} unknowns")
         self.GT = self.G.T.tocsr()
         self.minv_gt = sp.diags(1.0 / mass) @ self.GT
-        a = (self.G @ self.minv_gt).tocsc()
         try:
-            self.lu = spla.splu(a)
-            pivots = np.abs(self.lu.U.diagonal())
-            singular = not pivots.min() > 1e-12 * pivots.max()
-        except RuntimeError:
+            self.lu = linear_solver(self.G @ self.minv_gt, solver="serial")
+            singular = not self.lu.pivot_ratio() > 1e-12
+        except InputError:
             singular = True
         if singular:
             raise InputError("the constraint rows are linearly dependent (G M^-1 G^T is singular); "

@@ -141,7 +141,7 @@ def integrate(stepper: Newmark, model: Model, times: Sequence[float], *, start: 
         restore_run(ck, model, recorder)
         resumed = k
     else:
-        s = start if start is not None else stepper.start(model, t0=float(t_all[0]))
+        s = start if start is not None else stepper.start(model, t0=float(t_all[0]), comm=solves.comm)
         if abs(s.t - t_all[0]) > 1e-12 * max(abs(t_all[0]), 1.0):
             raise InputError(f"the start state is at t = {s.t:.6g}, the step times start at {t_all[0]:.6g}")
     substeps = cuts = iterations = 0

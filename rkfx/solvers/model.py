@@ -16,7 +16,7 @@ iteration or a cut step never touches committed state, and checkpoints save ``st
 The steppers only call the methods below; ``rkfx.solvers.newmark`` and
 ``rkfx.solvers.quasi_static`` document which they need.
 """
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
@@ -49,6 +49,34 @@ class Constraints:
 def no_constraints(size: int) -> Constraints:
     """The empty set of essential conditions for ``size`` unknowns."""
     return Constraints(sp.csr_matrix((0, size)), np.zeros(0))
+
+
+def step_key(dt: float) -> float:
+    """dt to 10 significant digits: steps of one size taken as differences of step times, which
+    differ in their last bits (by about 1e-16 t), share a key whatever the unit of time."""
+    return float(f"{dt:.10g}")
+
+
+class PerStepSize:
+    """What a model builds for one step size (capacity, stabilization), kept for the last few sizes.
+
+    Args:
+        keep: How many step sizes to keep per kind; the oldest goes first.
+    """
+
+    def __init__(self, keep: int = 4):
+        self.keep = keep
+        self._values: dict[tuple[str, float], object] = {}
+
+    def get(self, what: str, dt: float, build: Callable[[float], object]):
+        """``build(dt)`` for this kind and step size, built once while kept."""
+        key = (what, step_key(dt))
+        if key not in self._values:
+            same = [k for k in self._values if k[0] == what]
+            if len(same) >= self.keep:
+                del self._values[same[0]]
+            self._values[key] = build(dt)
+        return self._values[key]
 
 
 @runtime_checkable

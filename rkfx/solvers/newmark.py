@@ -30,8 +30,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from rkfx.errors import InputError
-from rkfx.linalg.linear_solver import Factorizations
-from rkfx.solvers.model import Constraints, Model, equation_weights
+from rkfx.linalg.linear_solver import Factorizations, linear_solver
+from rkfx.solvers.model import Constraints, Model, equation_weights, step_key
 from rkfx.solvers.newton import NewtonOptions, NewtonResult, newton
 
 
@@ -147,9 +147,9 @@ class Newmark:
         return x, v
 
     def start(self, model: Model, x0: np.ndarray | None = None, v0: np.ndarray | None = None,
-              a0: np.ndarray | None = None, t0: float = 0.0) -> StepState:
+              a0: np.ndarray | None = None, t0: float = 0.0, comm=None) -> StepState:
         """The state at t0. Rates default to zero, except that a0 of second-order fields
-        follows from M a0 = -(C v0 + r(x0, t0)) when the model has a mass."""
+        follows from M a0 = -(C v0 + r(x0, t0)) when the model has a mass (solved on comm)."""
         n = model.layout.size
         x = np.zeros(n) if x0 is None else np.array(x0, float).reshape(n)
         v = np.zeros(n) if v0 is None else np.array(v0, float).reshape(n)
@@ -169,9 +169,9 @@ class Newmark:
                 if mm.nnz == mm.shape[0] and np.all(mm.diagonal() != 0):
                     a[o2] = rhs[o2] / mm.diagonal()
                 else:
-                    import scipy.sparse.linalg as spla  # noqa: PLC0415
-
-                    a[o2] = spla.spsolve(mm.tocsc(), rhs[o2])
+                    ls = linear_solver(mm, comm)
+                    a[o2] = ls.solve(rhs[o2])
+                    ls.destroy()
         k = model.constraints(t0).count
         return StepState(0, float(t0), x, v, a, np.zeros(k))
 
@@ -221,8 +221,10 @@ class _Plan:
             raise InputError("an essential condition couples explicit and implicit unknowns; "
                              "constrain each field on its own rows")
         self.any_explicit = bool(self.on_explicit.any())
-        self.lumped = _lumped(model.mass(), model.capacity(dt), model.layout.orders, explicit) \
-            if self.any_explicit else None
+        self.projection = None
+        if self.any_explicit:
+            weight = _lumped(model.mass(), model.capacity(dt), model.layout.orders, explicit)
+            self.projection = _Projection(self.G[self.on_explicit], weight)
 
     def scaled_rows(self, co: Coefficients) -> sp.csr_matrix:
         """G diag(dx) on value rows, G diag(dv) on rate rows."""
@@ -255,7 +257,7 @@ class _NewmarkSystem:
         self.linear = plan.linear
         on_explicit = plan.on_explicit
         if on_explicit.any():
-            x_t = _project(x_t, self.G[on_explicit], con.g[on_explicit], plan.lumped)
+            x_t = plan.projection.project(x_t, con.g[on_explicit])
             # dg/dt at t1: the model's, or the difference over the step.
             rate = con.rate if con.rate is not None else (con.g - model.constraints(t0).g) / (t1 - t0)
         self.x_t, self.v_t = x_t, v_t
@@ -323,12 +325,6 @@ class _NewmarkSystem:
         return bool(ok_eq and ok_con)
 
 
-def step_key(dt: float) -> float:
-    """dt to 10 significant digits: steps of one size taken as differences of step times, which
-    differ in their last bits (by about 1e-16 t), share a key whatever the unit of time."""
-    return float(f"{dt:.10g}")
-
-
 def _scale_columns(a: sp.csr_matrix, scale: np.ndarray) -> sp.csr_matrix:
     """a diag(scale), as a copy (a scalar multiple when the scale is uniform)."""
     if np.all(scale == scale[0]):
@@ -343,13 +339,17 @@ def _scale_rows(a: sp.spmatrix, scale: np.ndarray) -> sp.csr_matrix:
     return a
 
 
-def _project(x: np.ndarray, G: sp.csr_matrix, g: np.ndarray, weight: np.ndarray) -> np.ndarray:
-    """x + W^-1 G^T lambda with G (x + ...) = g: the weighted projection onto the constraints."""
-    import scipy.sparse.linalg as spla  # noqa: PLC0415
+class _Projection:
+    """x + W^-1 G^T lambda with G (x + ...) = g: the weighted projection onto the constraints,
+    G W^-1 G^T factorized once (a small system, on every rank)."""
 
-    winv_gt = sp.diags(1.0 / weight) @ G.T
-    lam = spla.spsolve(sp.csc_matrix(G @ winv_gt), g - G @ x)
-    return x + winv_gt @ np.atleast_1d(lam)
+    def __init__(self, G: sp.csr_matrix, weight: np.ndarray):
+        self.G = G
+        self.winv_gt = (sp.diags(1.0 / weight) @ G.T).tocsr()
+        self.solver = linear_solver(G @ self.winv_gt, solver="serial")
+
+    def project(self, x: np.ndarray, g: np.ndarray) -> np.ndarray:
+        return x + self.winv_gt @ np.atleast_1d(self.solver.solve(g - self.G @ x))
 
 
 def theta_method(theta: float, **options) -> Newmark:
