@@ -18,8 +18,9 @@ import numpy as np
 
 import dolfinx_solver  # noqa: F401  (MPI before petsc4py)
 from fem_baselines import poroelasticity as fb
+from rkfx.conditions import Displacement, Pressure, split
 from rkfx.geometry.particles import structured
-from rkfx.models.poroelasticity import Displacement, PoroMaterial, Pressure, solve_biot, time_grid, zero
+from rkfx.models.poroelasticity import PoroMaterial, solve_biot, time_grid, zero
 from rkfx.warmup import warm_up
 from verification.mandel import Mandel
 
@@ -28,20 +29,22 @@ T_D = np.array([0.02, 0.05])
 DT_D = 2.5e-5
 
 
-def rkpm(nx, ny, material, exact, times, outputs, x):
+def conditions(exact):
+    """Rollers left and bottom, the rigid plate's displacement on top, drained right side: both solvers'."""
+    return [Displacement("left", zero, (0,)), Displacement("bottom", zero, (1,)),
+            Displacement("top", lambda xx, t: np.full(len(xx), exact.plate_displacement(t)), (1,)),
+            Pressure("right", lambda xx, t: np.zeros(len(xx)))]
+
+
+def rkpm(nx, ny, material, bcs, times, outputs, x):
     p = structured(LX, LY, nx, ny)
-    sol = solve_biot(p, material, times, outputs,
-                     [Displacement("left", zero, (0,)), Displacement("bottom", zero, (1,)),
-                      Displacement("top", lambda xx, t: np.full(len(xx), exact.plate_displacement(t)), (1,))],
-                     [Pressure("right", lambda xx, t: np.zeros(len(xx)))], variant="scni+fpp")
+    kinds = split(bcs)
+    sol = solve_biot(p, material, times, outputs, kinds[Displacement], kinds[Pressure], variant="scni+fpp")
     return sol.pressure(np.column_stack([x, 0 * x])), sol.wall_time_s, sol.n_dofs
 
 
-def taylor_hood(nx, ny, material, exact, times, outputs, x):
+def taylor_hood(nx, ny, material, bcs, times, outputs, x):
     mesh = fb.rectangle_mesh(np.linspace(0, LX, nx), np.linspace(0, LY, ny), "triangle")
-    bcs = [fb.Displacement("left", 0, 0.0), fb.Displacement("bottom", 1, 0.0),
-           fb.Displacement("top", 1, lambda xx, t: np.full(xx.shape[1], exact.plate_displacement(t))),
-           fb.Pressure("right", 0.0)]
     res = fb.solve_biot(mesh, E, NU, K, 1.0, 0.0, "taylor-hood", bcs, times, np.column_stack([x, 0 * x]), outputs)
     return res.p, res.wall_time_s, res.n_dofs
 
@@ -56,16 +59,17 @@ def main(argv=None):
     times = time_grid(outputs, DT_D * LX**2 / exact.c)
     x = np.linspace(0.0, LX, 401)
     p_exact = np.array([exact.pressure(x, t) for t in outputs])
+    bcs = conditions(exact)
     warm_up()
     for solve in (rkpm, taylor_hood):  # compile forms / kernels outside the timings
-        solve(11, 3, material, exact, times[:3], times[2:3], x)
+        solve(11, 3, material, bcs, times[:3], times[2:3], x)
     rows = {"rkpm": [], "th": []}
     print(f"{len(times) - 1} time steps for every run\n")
     print(f"{'method':<14} {'nodes':>12} {'dofs':>8} {'wall [s]':>9} {'rel L2(p)':>10}")
     for nx in args.nx:
         ny = (nx - 1) // 10 + 1
         for key, solve in (("rkpm", rkpm), ("th", taylor_hood)):
-            p_h, wall, dofs = solve(nx, ny, material, exact, times, outputs, x)
+            p_h, wall, dofs = solve(nx, ny, material, bcs, times, outputs, x)
             err = max(np.linalg.norm(a - b) / np.linalg.norm(b) for a, b in zip(p_h, p_exact))
             rows[key].append((err, wall))
             name = "RKPM SCNI+FPP" if key == "rkpm" else "Taylor-Hood"

@@ -6,7 +6,7 @@ The model is converted with :func:`dolfinx.io.gmsh.model_to_mesh` (read on
 rank 0, distributed over ``comm``), then the problem
 
     -div sigma(u) = f   in Omega,
-    u = g               on Gamma_D (all components or one component),
+    u_c = g_c           on Gamma_D (the listed components c),
     sigma(u) n = t      on Gamma_N,
 
 is solved with vector Lagrange P``degree`` elements on triangles and a direct
@@ -14,19 +14,23 @@ MUMPS LU factorisation, with the plane-strain constitutive law
 ``sigma = lambda tr(eps) I + 2 mu eps``, lambda and mu from
 :class:`rkfx.materials.elasticity.ElasticMaterial` (the law of the RKPM solvers).
 
+Boundary conditions are ``Displacement`` and ``Traction`` of ``rkfx.conditions``,
+the RKPM solvers' vocabulary; ``fem_baselines.conditions`` resolves their parts
+and evaluates their values on the dolfinx mesh.
+
 Units are whatever the caller uses consistently (e.g. m, Pa, N/m^3); the
 module never rescales anything.
 
-All dolfinx-specific calls of the FEM baselines live in this module (and in
-:mod:`fem_baselines.assembly_timing`). Importing it has no side effects beyond
-importing dolfinx (``dolfinx_solver`` is imported first, as it must be).
+The other dolfinx-specific calls of the elastic FEM baseline live in this module
+(and in :mod:`fem_baselines.assembly_timing`). Importing it has no side effects
+beyond importing dolfinx (``dolfinx_solver`` is imported first, as it must be).
 """
 
 from __future__ import annotations
 
 import itertools
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -43,6 +47,8 @@ import dolfinx.io.gmsh
 import dolfinx.mesh
 import ufl
 
+from fem_baselines.conditions import BoundaryParts, check_kinds
+from rkfx.conditions import Condition, Displacement, Traction
 from rkfx.materials.elasticity import ElasticMaterial
 
 __all__ = [
@@ -52,12 +58,6 @@ __all__ = [
     "strain",
     "stress_law",
 ]
-
-#: A boundary is named by a physical-group name (str), a facet-tag value
-#: (int), or a marker ``m(x) -> bool array`` with ``x`` of shape (3, npts)
-#: selecting boundary facets geometrically (see
-#: :func:`dolfinx.mesh.locate_entities_boundary`).
-BoundaryKey = str | int | Callable[[np.ndarray], np.ndarray]
 
 #: A vector field given as a callable ``g(x)``, ``x`` of shape (2, npts),
 #: returning shape (2, npts) (or (2,) for a constant), or as a constant
@@ -202,23 +202,6 @@ def _vector_values(data: VectorData, x: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(np.broadcast_to(val, (2, npts)))
 
 
-def _scalar_values(data: Any, x: np.ndarray) -> np.ndarray:
-    """Evaluate scalar data (callable of x (2, npts) -> (npts,), or a number).
-
-    Args:
-        data: Callable or constant.
-        x: Interpolation points from dolfinx, shape (3, npts).
-
-    Returns:
-        Array of shape (npts,).
-    """
-    npts = x.shape[1]
-    val = np.asarray(data(x[:2]) if callable(data) else data, dtype=np.float64)
-    if val.ndim == 0:
-        return np.full(npts, float(val))
-    return np.ascontiguousarray(val.reshape(npts))
-
-
 def _to_mesh_data(model_or_mesh: Any, comm: MPI.Comm):
     """Normalise the geometry argument to (mesh, facet_tags, physical_groups)."""
     if isinstance(model_or_mesh, dolfinx.io.gmsh.MeshData):
@@ -231,47 +214,11 @@ def _to_mesh_data(model_or_mesh: Any, comm: MPI.Comm):
     return md.mesh, md.facet_tags, dict(md.physical_groups)
 
 
-def _boundary_facets(
-    key: BoundaryKey,
-    mesh: dolfinx.mesh.Mesh,
-    facet_tags: Any,
-    physical_groups: Mapping[str, Any],
-) -> np.ndarray:
-    """Local indices of the facets of a named / tagged / marked boundary part.
-
-    Args:
-        key: Physical-group name, facet-tag value, or marker callable.
-        mesh: The dolfinx mesh.
-        facet_tags: Facet MeshTags (needed for str and int keys).
-        physical_groups: Name -> (dim, tag) (needed for str keys).
-
-    Returns:
-        Sorted unique local facet indices, int32 array of shape (nfacets,).
-    """
-    fdim = mesh.topology.dim - 1
-    if callable(key):
-        return np.asarray(dolfinx.mesh.locate_entities_boundary(mesh, fdim, key), dtype=np.int32)
-    if isinstance(key, str):
-        if key not in physical_groups:
-            raise KeyError(f"no physical group named {key!r}; have {sorted(physical_groups)}")
-        dim, tag = physical_groups[key]
-        if dim != fdim:
-            raise ValueError(f"physical group {key!r} has dimension {dim}, expected {fdim} (facets)")
-    elif isinstance(key, (int, np.integer)):
-        tag = int(key)
-    else:
-        raise TypeError(f"boundary key must be str, int or callable, got {type(key).__name__}")
-    if facet_tags is None:
-        raise ValueError(f"boundary {key!r} given by name/tag but the mesh has no facet tags")
-    return np.asarray(facet_tags.find(int(tag)), dtype=np.int32)
-
-
 def solve_plane_strain(
     model_or_mesh: Any,
     E: float,
     nu: float,
-    dirichlet: Mapping[BoundaryKey, Any],
-    tractions: Mapping[BoundaryKey, VectorData] | None = None,
+    conditions: Sequence[Condition],
     body_force: VectorData | None = None,
     degree: int = 1,
     comm: MPI.Comm | None = None,
@@ -286,22 +233,19 @@ def solve_plane_strain(
             for the domain and 1D physical groups naming boundary parts (only
             rank 0 needs the model; it is distributed over ``comm``); or a
             :class:`dolfinx.io.gmsh.MeshData` already converted; or a bare
-            :class:`dolfinx.mesh.Mesh` (boundaries then given by marker
-            callables).
+            :class:`dolfinx.mesh.Mesh` (boundaries then given by the sides of
+            its bounding box or by markers).
         E: Young's modulus (stress units, e.g. Pa).
         nu: Poisson's ratio (dimensionless, < 0.5).
-        dirichlet: Boundary -> prescribed displacement. The key is a
-            physical-group name (str), a facet-tag value (int) or a marker
-            ``m(x) -> bool (npts,)`` with x of shape (3, npts). The value is
-            either ``g`` -- a callable ``g(x)``, x of shape (2, npts), returning
-            both components, shape (2, npts) (or a constant of shape (2,)) --
-            or a tuple ``(component, g)`` fixing only that component
-            (0 = x, 1 = y; a roller), ``g(x)`` returning shape (npts,) (or a
-            number). Length units.
-        tractions: Boundary -> surface traction ``t(x)``, x of shape
-            (2, npts), returning shape (2, npts) (or a constant of shape (2,)),
-            in stress units. Boundaries given here must be disjoint. None for
-            no tractions (traction-free where no Dirichlet data is given).
+        conditions: ``rkfx.conditions.Displacement`` (the listed components;
+            one component is a roller) and ``rkfx.conditions.Traction`` objects,
+            evaluated at t = 0: values are constants or ``value(x, t)``
+            (displacements, length units) and ``value(x, t, n)`` (tractions,
+            stress units), x and the outward unit normals n of shape
+            (m, 2). Parts are physical-group names, facet tags (int), sides of
+            the bounding box or markers ``x (m, 2) -> bool`` (see
+            ``fem_baselines.conditions``); traction parts must be disjoint.
+            Boundaries without conditions are traction-free.
         body_force: Body force per unit volume ``f(x)``, x of shape (2, npts),
             returning shape (2, npts) (or a constant of shape (2,)), e.g. N/m^3.
             None for no body force.
@@ -313,10 +257,11 @@ def solve_plane_strain(
         The solution; see :class:`FemElasticityResult`.
 
     Note:
-        Traction and body-force callables are interpolated into a vector
-        Lagrange space of degree ``degree + 1`` (so that data interpolation
-        does not limit the convergence rate); Dirichlet data is interpolated
-        into the solution space. E and nu enter the forms as dolfinx
+        Tractions and body forces are interpolated into a vector Lagrange
+        space of degree ``degree + 1`` (so that data interpolation does not
+        limit the convergence rate), tractions on the cells next to their
+        parts only; Dirichlet data is interpolated into the solution space
+        on the cells next to its part. E and nu enter the forms as dolfinx
         Constants, so changing them does not trigger a new form compilation.
     """
     if degree < 1:
@@ -337,23 +282,22 @@ def solve_plane_strain(
     W = dolfinx.fem.functionspace(mesh, ("Lagrange", degree + 1, (2,)))
     scalar = dolfinx.default_scalar_type
 
-    # Dirichlet conditions.
+    # Dirichlet conditions: all components on V, one component (a roller) on its subspace.
+    kinds = check_kinds(conditions, (Displacement, Traction), "solve_plane_strain", gdim=2)
+    parts = BoundaryParts(mesh, facet_tags, physical_groups)
     bcs = []
-    for key, spec in dirichlet.items():
-        facets = _boundary_facets(key, mesh, facet_tags, physical_groups)
-        if isinstance(spec, tuple):
-            comp, g = spec
-            comp = int(comp)
-            if comp not in (0, 1):
-                raise ValueError(f"Dirichlet component must be 0 or 1, got {comp}")
+    for c in kinds[Displacement]:
+        facets = parts.facets(c.boundary)
+        if len(c.components) == 1:
+            comp = c.components[0]
             Vc, _ = V.sub(comp).collapse()
             gc = dolfinx.fem.Function(Vc)
-            gc.interpolate(lambda x, g=g: _scalar_values(g, x))
+            parts.interpolate(gc, c, 0.0)
             dofs = dolfinx.fem.locate_dofs_topological((V.sub(comp), Vc), fdim, facets)
             bcs.append(dolfinx.fem.dirichletbc(gc, dofs, V.sub(comp)))
         else:
             gv = dolfinx.fem.Function(V)
-            gv.interpolate(lambda x, g=spec: _vector_values(g, x))
+            parts.interpolate(gv, c, 0.0)
             dofs = dolfinx.fem.locate_dofs_topological(V, fdim, facets)
             bcs.append(dolfinx.fem.dirichletbc(gv, dofs))
 
@@ -369,19 +313,12 @@ def solve_plane_strain(
         f = dolfinx.fem.Function(W, name="body_force")
         f.interpolate(lambda x: _vector_values(body_force, x))
         rhs.append(ufl.inner(f, v) * ufl.dx)
-    if tractions:
-        parts = [_boundary_facets(k, mesh, facet_tags, physical_groups) for k in tractions]
-        all_facets = np.concatenate(parts)
-        values = np.concatenate([np.full(p.size, i + 1, dtype=np.int32) for i, p in enumerate(parts)])
-        order = np.argsort(all_facets, kind="stable")
-        all_facets, values = all_facets[order], values[order]
-        if np.any(np.diff(all_facets) == 0):
-            raise ValueError("traction boundaries overlap; give each facet one traction")
-        traction_tags = dolfinx.mesh.meshtags(mesh, fdim, all_facets, values)
-        ds = ufl.Measure("ds", domain=mesh, subdomain_data=traction_tags)
-        for i, t_data in enumerate(tractions.values()):
+    if kinds[Traction]:
+        tags = parts.tags([c.boundary for c in kinds[Traction]], "traction")
+        ds = ufl.Measure("ds", domain=mesh, subdomain_data=tags)
+        for i, c in enumerate(kinds[Traction]):
             t = dolfinx.fem.Function(W, name=f"traction_{i}")
-            t.interpolate(lambda x, t_data=t_data: _vector_values(t_data, x))
+            parts.interpolate(t, c, 0.0)
             rhs.append(ufl.inner(t, v) * ds(i + 1))
     if rhs:
         L = sum(rhs[1:], rhs[0])

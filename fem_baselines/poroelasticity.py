@@ -46,8 +46,10 @@ Elements: ``"taylor-hood"`` (P2-P1 on triangles, Q2-Q1 on quadrilaterals; inf-su
 ``"q1q1"`` (equal-order Q1-Q1 on quadrilaterals, P1-P1 on triangles; unstabilised, oscillates
 in the undrained limit) and ``"q1q1-fpp"`` (the same with FPP).
 
-All dolfinx-specific calls of the poroelastic FEM baseline live in this module. Importing it has
-no side effects beyond importing dolfinx (``dolfinx_solver`` first, as it must be).
+Boundary conditions are those of ``rkfx.conditions``, the RKPM model's; parts and values reach
+dolfinx through ``fem_baselines.conditions``. The other dolfinx-specific calls of the poroelastic
+FEM baseline live in this module. Importing it has no side effects beyond importing dolfinx
+(``dolfinx_solver`` first, as it must be).
 """
 
 from __future__ import annotations
@@ -73,7 +75,9 @@ import dolfinx.la
 import dolfinx.mesh
 import ufl
 
+from fem_baselines.conditions import BoundaryParts, check_kinds
 from fem_baselines.elasticity import strain, stress_law
+from rkfx.conditions import Condition, Displacement, Flux, Pressure, Traction, values
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.linalg.linear_solver import Factorizations
 from rkfx.models.poroelasticity import PoroMaterial, fpp_parameter
@@ -85,87 +89,16 @@ from rkfx.solvers.newmark import StepState, backward_euler
 
 __all__ = [
     "BiotResult",
-    "Displacement",
     "FemBiotModel",
-    "Flux",
-    "Pressure",
-    "Traction",
     "rectangle_mesh",
     "solve_biot",
 ]
-
-#: A boundary part: one of ``"left"``, ``"right"``, ``"bottom"``, ``"top"`` (the sides of the
-#: mesh's bounding box, located by coordinates), or a marker ``m(x) -> bool array`` with ``x`` of
-#: shape (3, npts) selecting boundary facets geometrically.
-BoundaryKey = str | Callable[[np.ndarray], np.ndarray]
 
 ELEMENTS = ("taylor-hood", "q1q1", "q1q1-fpp")
 
 #: MUMPS controls beyond ``rkfx.linalg.petsc``'s: the AMF ordering (ICNTL(7) = 2) factorises the
 #: Mandel Taylor-Hood system 4x faster than the default.
 _MUMPS_ICNTL = {7: 2}
-
-# --------------------------------------------------------------------------- boundary data
-
-
-@dataclass(frozen=True)
-class Displacement:
-    """Prescribed displacement component on a boundary part.
-
-    Attributes:
-        boundary: Boundary part (see :data:`BoundaryKey`).
-        component: 0 (x) or 1 (y).
-        value: ``value(x, t) -> (n,)`` [m] with ``x`` of shape (2, n) [m] and ``t`` [s], or a
-            number.
-    """
-
-    boundary: BoundaryKey
-    component: int
-    value: Callable[[np.ndarray, float], np.ndarray] | float = 0.0
-
-
-@dataclass(frozen=True)
-class Traction:
-    """Prescribed total traction ``(sigma'' - alpha p I) n`` on a boundary part.
-
-    Attributes:
-        boundary: Boundary part (see :data:`BoundaryKey`).
-        value: ``value(x, t) -> (2, n)`` [Pa] with ``x`` of shape (2, n) [m], or a constant
-            array-like of shape (2,).
-    """
-
-    boundary: BoundaryKey
-    value: Callable[[np.ndarray, float], np.ndarray] | Any
-
-
-@dataclass(frozen=True)
-class Pressure:
-    """Prescribed pore pressure on a boundary part (a drained boundary for value 0).
-
-    Attributes:
-        boundary: Boundary part (see :data:`BoundaryKey`).
-        value: ``value(x, t) -> (n,)`` [Pa] with ``x`` of shape (2, n) [m], or a number.
-    """
-
-    boundary: BoundaryKey
-    value: Callable[[np.ndarray, float], np.ndarray] | float = 0.0
-
-
-@dataclass(frozen=True)
-class Flux:
-    """Prescribed outward normal fluid flux ``q . n = -k grad p . n`` on a boundary part.
-
-    Attributes:
-        boundary: Boundary part (see :data:`BoundaryKey`).
-        value: ``value(x, t) -> (n,)`` [m/s] with ``x`` of shape (2, n) [m], or a number.
-    """
-
-    boundary: BoundaryKey
-    value: Callable[[np.ndarray, float], np.ndarray] | float
-
-
-BoundaryCondition = Displacement | Traction | Pressure | Flux
-
 
 @dataclass
 class BiotResult:
@@ -219,8 +152,8 @@ def rectangle_mesh(
     Cells are built on rank 0 and distributed by :func:`dolfinx.mesh.create_mesh`. For
     triangles every grid rectangle is split along its diagonal from (x_i, y_j) to
     (x_i+1, y_j+1) -- the same split everywhere, as in :func:`rkfx.geometry.particles.graded`.
-    The sides are found by coordinates in :func:`solve_biot` (names ``"left"``, ``"right"``,
-    ``"bottom"``, ``"top"``).
+    The sides are found by coordinates (boundary parts ``"left"``, ``"right"``, ``"bottom"``,
+    ``"top"`` of ``fem_baselines.conditions``).
 
     Args:
         xs: Strictly increasing x coordinates, shape (nx,) [m], nx >= 2 (may be non-uniform).
@@ -264,40 +197,17 @@ def rectangle_mesh(
 # --------------------------------------------------------------------------- helpers
 
 
-def _values(data: Any, x: np.ndarray, t: float, shape: tuple[int, ...]) -> np.ndarray:
-    """Evaluate boundary data ``data(x, t)`` (or a constant) at interpolation points.
-
-    Args:
-        data: Callable ``(x (2, n), t) -> shape + (n,)`` or a constant of shape ``shape``.
-        x: Interpolation points from dolfinx, shape (3, n).
-        t: Time [s].
-        shape: Value shape, ``()`` or ``(2,)``.
+def _initial(field_of_x: Callable[[np.ndarray], Any], x: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+    """An initial field ``field_of_x(x (2, n)) -> shape + (n,)`` at dolfinx's points x (3, n).
 
     Returns:
         Array of shape ``shape + (n,)``.
     """
     n = x.shape[1]
-    val = np.asarray(data(x[:2], t) if callable(data) else data, dtype=np.float64)
+    val = np.asarray(field_of_x(x[:2]), dtype=np.float64)
     if val.shape == shape:
         val = val[..., None]
     return np.ascontiguousarray(np.broadcast_to(val, (*shape, n)))
-
-
-def _boundary_marker(key: BoundaryKey, mesh: dolfinx.mesh.Mesh) -> Callable[[np.ndarray], np.ndarray]:
-    """Marker callable of a named side of the mesh's bounding box (or the marker itself)."""
-    if callable(key):
-        return key
-    sides = ("left", "right", "bottom", "top")
-    if key not in sides:
-        raise ValueError(f"boundary must be one of {sides} or a marker callable, got {key!r}")
-    x = mesh.geometry.x[:, :2]
-    lo = np.full(2, np.inf) if x.size == 0 else x.min(axis=0)
-    hi = np.full(2, -np.inf) if x.size == 0 else x.max(axis=0)
-    mesh.comm.Allreduce(MPI.IN_PLACE, lo, op=MPI.MIN)
-    mesh.comm.Allreduce(MPI.IN_PLACE, hi, op=MPI.MAX)
-    tol = 1e-10 * float(np.max(hi - lo))
-    axis, value = {"left": (0, lo[0]), "right": (0, hi[0]), "bottom": (1, lo[1]), "top": (1, hi[1])}[key]
-    return lambda X: np.abs(X[axis] - value) <= tol
 
 
 class _Sampler:
@@ -334,22 +244,6 @@ class _Sampler:
             self.comm.Allreduce(MPI.IN_PLACE, vals, op=MPI.SUM)
         vals[self.missing] = np.nan
         return vals[:, 2].copy(), vals[:, :2].copy()
-
-
-def _facet_tags(mesh: dolfinx.mesh.Mesh, keys: Sequence[BoundaryKey], what: str):
-    """Facet MeshTags giving boundary part i the tag i + 1 (parts must be disjoint)."""
-    fdim = mesh.topology.dim - 1
-    parts = [
-        np.asarray(dolfinx.mesh.locate_entities_boundary(mesh, fdim, _boundary_marker(key, mesh)), np.int32)
-        for key in keys
-    ]
-    facets = np.concatenate(parts)
-    values = np.concatenate([np.full(p.size, i + 1, dtype=np.int32) for i, p in enumerate(parts)])
-    order = np.argsort(facets, kind="stable")
-    facets, values = facets[order], values[order]
-    if np.any(np.diff(facets) == 0):
-        raise ValueError(f"{what} boundaries overlap; give each facet one {what}")
-    return dolfinx.mesh.meshtags(mesh, fdim, facets, values)
 
 
 # --------------------------------------------------------------------------- the model
@@ -402,14 +296,14 @@ class FemBiotModel:
 
     The blocks are assembled once (S per step size) by dolfinx into PETSc and gathered into
     scipy CSR on every rank; the loads and Dirichlet data are evaluated at t. Dirichlet
-    conditions are unit rows G x = g(t) on their dofs (a dof named by several conditions takes
-    the last one's value, as dolfinx's ``set_bc``).
+    conditions are unit rows G x = g(t) on their dofs, one row per prescribed component (a dof
+    named by several conditions takes the last one's value, as dolfinx's ``set_bc``).
 
     Args: as :func:`solve_biot`.
     """
 
     def __init__(self, mesh: dolfinx.mesh.Mesh, E: float, nu: float, k: float, alpha: float, S: float,
-                 element: str, bcs: Sequence[BoundaryCondition], fpp_form: str = "rate", t0: float = 0.0):
+                 element: str, conditions: Sequence[Condition], fpp_form: str = "rate", t0: float = 0.0):
         self.comm, self.material = mesh.comm, (E, nu, k, alpha, S)
         mesh.topology.create_connectivity(mesh.topology.dim - 1, mesh.topology.dim)
         self._degree = 2 if element == "taylor-hood" else 1  # of u
@@ -426,9 +320,11 @@ class FemBiotModel:
         self.linear = True
         self.fpp = element == "q1q1-fpp"
         self.seed = self.fpp and fpp_form == "seed"
+        kinds = check_kinds(conditions, (Displacement, Pressure, Traction, Flux), "the Biot FEM", gdim=2)
+        self.boundary = BoundaryParts(mesh)
         self._assemble(mesh)
-        self._natural_conditions(mesh, bcs)
-        self._essential_conditions(mesh, bcs)
+        self._natural_conditions(mesh, kinds[Traction], kinds[Flux])
+        self._essential_conditions(mesh, kinds[Displacement] + kinds[Pressure])
         self._t = float(t0)  # committed time (the seed form's step starts there)
         self._t_trial = self._t
         self._at: dict[str, tuple[float, Any]] = {}  # loads and constraints at the last t
@@ -465,53 +361,46 @@ class FemBiotModel:
             self._cell_area_global = _gather(comm, self._cell_area[: DG0.dofmap.index_map.size_local])
             self._m_eps = dolfinx.fem.form(self._eps_f * p * q * dx)
 
-    def _natural_conditions(self, mesh: dolfinx.mesh.Mesh, bcs: Sequence[BoundaryCondition]) -> None:
+    def _natural_conditions(self, mesh: dolfinx.mesh.Mesh, tractions: Sequence[Traction],
+                            fluxes: Sequence[Flux]) -> None:
         """Forms of F(t) (tractions on a V-like space) and Q(t) (fluxes on P2), data Functions at t."""
-        self._load_data: list[tuple[dolfinx.fem.Function, Any, tuple[int, ...]]] = []
+        self._load_data: list[tuple[dolfinx.fem.Function, Traction | Flux]] = []
         v, q = ufl.TestFunction(self.V), ufl.TestFunction(self.Q)
-        self._L_u = self._L_p = None
-        for kind, space, shape, term in ((Traction, ("Lagrange", self._degree, (2,)), (2,), lambda f: ufl.inner(f, v)),
-                                         (Flux, ("Lagrange", 2), (), lambda f: -f * q)):
-            parts = [bc for bc in bcs if isinstance(bc, kind)]
+        linear = {}
+        for what, parts, space, term in (("traction", tractions, ("Lagrange", self._degree, (2,)),
+                                          lambda f: ufl.inner(f, v)),
+                                         ("flux", fluxes, ("Lagrange", 2), lambda f: -f * q)):
             if not parts:
                 continue
-            what = kind.__name__.lower()
-            ds = ufl.Measure("ds", domain=mesh, subdomain_data=_facet_tags(mesh, [b.boundary for b in parts], what))
+            ds = ufl.Measure("ds", domain=mesh, subdomain_data=self.boundary.tags([b.boundary for b in parts], what))
             W = dolfinx.fem.functionspace(mesh, space)
             forms = []
             for i, bc in enumerate(parts):
                 fn = dolfinx.fem.Function(W)
-                self._load_data.append((fn, bc.value, shape))
+                self._load_data.append((fn, bc))
                 forms.append(term(fn) * ds(i + 1))
-            form = dolfinx.fem.form(sum(forms[1:], forms[0]))
-            if kind is Traction:
-                self._L_u = form
-            else:
-                self._L_p = form
+            linear[what] = dolfinx.fem.form(sum(forms[1:], forms[0]))
+        self._L_u, self._L_p = linear.get("traction"), linear.get("flux")
 
-    def _essential_conditions(self, mesh: dolfinx.mesh.Mesh, bcs: Sequence[BoundaryCondition]) -> None:
+    def _essential_conditions(self, mesh: dolfinx.mesh.Mesh, essential: Sequence[Displacement | Pressure]) -> None:
         """Unit rows G on the owned dofs of each Dirichlet condition, data evaluated at their coordinates."""
         fdim = mesh.topology.dim - 1
-        self._dirichlet = []  # (data, coordinates (3, m), global rows (m,)) of each condition
+        self._dirichlet = []  # (condition, coordinates (m, 2), global rows (m,), value column (m,)) of each
         v_owned, q_owned = 2 * self.V.dofmap.index_map.size_local, self.Q.dofmap.index_map.size_local
         v_points, q_points = self.V.tabulate_dof_coordinates(), self.Q.tabulate_dof_coordinates()
-        for bc in bcs:
-            if isinstance(bc, (Traction, Flux)):
-                continue
-            if not isinstance(bc, (Displacement, Pressure)):
-                raise TypeError(f"unknown boundary condition {bc!r}")
-            facets = dolfinx.mesh.locate_entities_boundary(mesh, fdim, _boundary_marker(bc.boundary, mesh))
-            if isinstance(bc, Displacement):
-                if bc.component not in (0, 1):
-                    raise ValueError(f"Displacement component must be 0 or 1, got {bc.component}")
-                dofs = dolfinx.fem.locate_dofs_topological(self.V.sub(bc.component), fdim, facets)  # unrolled
-                dofs = dofs[dofs < v_owned]
-                self._dirichlet.append((bc.value, v_points[dofs // 2].T, self.u_index[dofs]))
+        for bc in essential:
+            facets = self.boundary.facets(bc.boundary)
+            if isinstance(bc, Displacement):  # the rows of every component, component by component
+                dofs = [dolfinx.fem.locate_dofs_topological(self.V.sub(c), fdim, facets) for c in bc.components]
+                dofs = [d[d < v_owned] for d in dofs]  # unrolled
+                column = np.concatenate([np.full(d.size, j) for j, d in enumerate(dofs)])
+                dofs = np.concatenate(dofs)
+                self._dirichlet.append((bc, v_points[dofs // 2, :2], self.u_index[dofs], column))
             else:
                 dofs = dolfinx.fem.locate_dofs_topological(self.Q, fdim, facets)
                 dofs = dofs[dofs < q_owned]
-                self._dirichlet.append((bc.value, q_points[dofs].T, self.p_index[dofs]))
-        rows = _in_order(self.comm, [r for _, _, r in self._dirichlet]).astype(np.int64)
+                self._dirichlet.append((bc, q_points[dofs, :2], self.p_index[dofs], np.zeros(dofs.size, int)))
+        rows = _in_order(self.comm, [r for _, _, r, _ in self._dirichlet]).astype(np.int64)
         self._bc_rows, last = np.unique(rows[::-1], return_index=True)
         self._bc_last = len(rows) - 1 - last  # where each constrained dof's value stands in the gathered list
         k = len(self._bc_rows)
@@ -546,9 +435,9 @@ class FemBiotModel:
         """[F(t), Q(t)], shape ``(size,)``."""
         def build(t):
             first = "loads" not in self._at
-            for fn, data, shape in self._load_data:
-                if callable(data) or first:
-                    fn.interpolate(lambda X, data=data, shape=shape: _values(data, X, t, shape))
+            for fn, bc in self._load_data:
+                if callable(bc.value) or first:
+                    self.boundary.interpolate(fn, bc, t)
             f = np.zeros(self.layout.size)
             if self._L_u is not None:
                 f[: self._n_u] = _global_vector(self._L_u, self.comm)
@@ -556,15 +445,15 @@ class FemBiotModel:
                 f[self._n_u:] = _global_vector(self._L_p, self.comm)
             return f
 
-        return self._cached("loads", t, any(callable(d) for _, d, _ in self._load_data), build)
+        return self._cached("loads", t, any(callable(bc.value) for _, bc in self._load_data), build)
 
     def constraints(self, t: float) -> Constraints:
         def build(t):
-            self._bc_values = [_values(data, x, t, ()) if callable(data) or old is None else old
-                               for (data, x, _), old in zip(self._dirichlet, self._bc_values)]
+            self._bc_values = [values(bc, x, t)[np.arange(len(x)), column] if callable(bc.value) or old is None
+                               else old for (bc, x, _, column), old in zip(self._dirichlet, self._bc_values)]
             return Constraints(self._G, _in_order(self.comm, self._bc_values)[self._bc_last])
 
-        return self._cached("constraints", t, any(callable(d) for d, _, _ in self._dirichlet), build)
+        return self._cached("constraints", t, any(callable(bc.value) for bc, _, _, _ in self._dirichlet), build)
 
     # ------------------------------------------------------------------ matrices
 
@@ -664,7 +553,7 @@ def solve_biot(
     alpha: float,
     S: float,
     element: str,
-    bcs: Sequence[BoundaryCondition],
+    conditions: Sequence[Condition],
     times: np.ndarray,
     sample_points: np.ndarray,
     output_times: np.ndarray,
@@ -678,7 +567,7 @@ def solve_biot(
 ) -> BiotResult:
     """Solve plane-strain Biot consolidation with backward Euler and a monolithic u-p solve.
 
-    Collective on the mesh communicator. Boundaries not mentioned in ``bcs`` are traction-free
+    Collective on the mesh communicator. Boundaries not mentioned in ``conditions`` are traction-free
     and impermeable. The :class:`FemBiotModel` is stepped by ``rkfx.solvers.integrate`` with
     ``backward_euler()``: one Newton iteration per step, one MUMPS factorisation per distinct
     time step.
@@ -692,8 +581,12 @@ def solve_biot(
         S: Storage coefficient 1/Q [1/Pa]; 0 for incompressible constituents.
         element: ``"taylor-hood"`` (P2-P1 / Q2-Q1), ``"q1q1"`` (equal order, unstabilised) or
             ``"q1q1-fpp"`` (equal order with fluid pressure projection, eqs. 3.49-3.54).
-        bcs: Boundary conditions: :class:`Displacement`, :class:`Traction`, :class:`Pressure`,
-            :class:`Flux` instances. Data callables are evaluated at t_{n+1} in step n+1.
+        conditions: Boundary conditions of ``rkfx.conditions``: ``Displacement`` (a row per
+            listed component), ``Pressure``, ``Traction`` (total traction) and ``Flux`` (outward
+            normal flux). Parts are the sides ``"left"``, ``"right"``, ``"bottom"``, ``"top"``
+            of the mesh's bounding box or markers ``x (m, 2) -> bool`` (see
+            ``fem_baselines.conditions``). Functions of x and t (of x, t and n for tractions and
+            fluxes) are evaluated at t_{n+1} in step n+1.
         times: Time levels t_0 < t_1 < ... < t_N, shape (N+1,) [s]; the initial state is at t_0.
         sample_points: Points where fields are sampled, shape (m, 2) [m].
         output_times: Times at which to sample, each exactly equal to an entry of ``times``,
@@ -717,7 +610,7 @@ def solve_biot(
         The sampled history and final fields; see :class:`BiotResult`.
 
     Raises:
-        ValueError: On inconsistent input.
+        ValueError: On inconsistent input (``rkfx.errors.InputError`` for the conditions).
         rkfx.errors.SolverError: If a linear solve fails.
     """
     t_start = time.perf_counter()
@@ -741,13 +634,13 @@ def solve_biot(
     if not (E > 0 and -1.0 < nu < 0.5 and k >= 0 and S >= 0):
         raise ValueError(f"need E > 0, -1 < nu < 0.5, k >= 0, S >= 0; got E={E}, nu={nu}, k={k}, S={S}")
 
-    model = FemBiotModel(mesh, E, nu, k, alpha, S, element, bcs, fpp_form, t0=float(times[0]))
+    model = FemBiotModel(mesh, E, nu, k, alpha, S, element, conditions, fpp_form, t0=float(times[0]))
     uh = dolfinx.fem.Function(model.V, name="u")
     ph = dolfinx.fem.Function(model.Q, name="p")
     if initial_u is not None:
-        uh.interpolate(lambda x: _values(lambda X, t: initial_u(X), x, times[0], (2,)))
+        uh.interpolate(lambda x: _initial(initial_u, x, (2,)))
     if initial_p is not None:
-        ph.interpolate(lambda x: _values(lambda X, t: initial_p(X), x, times[0], ()))
+        ph.interpolate(lambda x: _initial(initial_p, x, ()))
     n = model.layout.size
     start = StepState(0, float(times[0]), model.vector(uh, ph), np.zeros(n), np.zeros(n),
                       np.zeros(model.num_constraints))

@@ -21,6 +21,9 @@ from fem_baselines.elasticity import (  # noqa: E402
     errors,
     solve_plane_strain,
 )
+from fem_baselines.conditions import BoundaryParts  # noqa: E402
+from rkfx.conditions import Displacement, Pressure, Traction  # noqa: E402
+from rkfx.errors import InputError  # noqa: E402
 from rkfx.materials.elasticity import ElasticMaterial  # noqa: E402
 
 E_MMS, NU_MMS = 1.0, 0.3
@@ -149,7 +152,7 @@ def mms_study():
                     model,
                     E_MMS,
                     NU_MMS,
-                    dirichlet={side: u_mms for side in SIDES},
+                    [Displacement(side, lambda x, t: u_mms(x.T).T) for side in SIDES],
                     body_force=f_mms,
                     degree=degree,
                 )
@@ -225,9 +228,19 @@ def u_lin(x: np.ndarray) -> np.ndarray:
     return A0[:, None] + B @ x
 
 
+def u_lin_bc(x: np.ndarray, t: float) -> np.ndarray:
+    """u_lin as a condition's value: x (m, 2) -> (m, 2)."""
+    return u_lin(x.T).T
+
+
 def _traction(normal):
     t = S @ np.asarray(normal, dtype=float)
-    return lambda x: np.repeat(t[:, None], x.shape[1], axis=1)
+    return lambda x, time, n: np.tile(t, (len(x), 1))
+
+
+def s_n(x: np.ndarray, t: float, n: np.ndarray) -> np.ndarray:
+    """The patch's traction sigma n on any side, from the facet normals."""
+    return n @ S.T
 
 
 def _max_nodal_error(res) -> float:
@@ -243,8 +256,8 @@ def test_patch_test_linear_field_with_tractions():
             model,
             E_PATCH,
             NU_PATCH,
-            dirichlet={"left": u_lin, "bottom": u_lin},
-            tractions={"right": _traction((1.0, 0.0)), "top": _traction((0.0, 1.0))},
+            [Displacement("left", u_lin_bc), Displacement("bottom", u_lin_bc),
+             Traction("right", _traction((1.0, 0.0))), Traction("top", _traction((0.0, 1.0)))],
             degree=1,
         )
     assert _max_nodal_error(res) < 1e-10
@@ -254,24 +267,23 @@ def test_patch_test_linear_field_with_tractions():
 
 
 def test_patch_test_rollers_and_constant_data():
-    """Rollers (component, g) on left/bottom, tractions on all four sides."""
+    """Rollers on left/bottom, tractions on all four sides."""
     with unit_square_model(0.25) as model:
         res = solve_plane_strain(
             model,
             E_PATCH,
             NU_PATCH,
-            dirichlet={
-                "left": (0, lambda x: u_lin(x)[0]),
-                "bottom": (1, lambda x: u_lin(x)[1]),
-            },
-            tractions={
-                "right": S @ np.array([1.0, 0.0]),  # constant array data
-                "top": _traction((0.0, 1.0)),
-                "left": _traction((-1.0, 0.0)),
-                "bottom": _traction((0.0, -1.0)),
-            },
+            [
+                Displacement("left", lambda x, t: u_lin(x.T)[0], (0,)),
+                Displacement("bottom", u_lin_bc, (1,)),  # every component given, the listed one taken
+                Traction("right", S @ np.array([1.0, 0.0])),  # a constant vector
+                Traction("top", _traction((0.0, 1.0))),
+                Traction("left", s_n),  # from the outward normals
+                Traction("bottom", s_n),
+            ],
         )
     assert _max_nodal_error(res) < 1e-10
+
 
 
 def test_bare_mesh_with_marker_boundaries():
@@ -283,19 +295,70 @@ def test_bare_mesh_with_marker_boundaries():
         msh,
         E_PATCH,
         NU_PATCH,
-        dirichlet={lambda x: np.isclose(x[0], 0.0): u_lin, lambda x: np.isclose(x[1], 0.0): u_lin},
-        tractions={
-            lambda x: np.isclose(x[0], 1.0): _traction((1.0, 0.0)),
-            lambda x: np.isclose(x[1], 1.0): _traction((0.0, 1.0)),
-        },
+        [
+            Displacement(lambda x: np.isclose(x[:, 0], 0.0), u_lin_bc),
+            Displacement("bottom", u_lin_bc),  # a side of the bounding box
+            Traction(lambda x: np.isclose(x[:, 0], 1.0), _traction((1.0, 0.0))),
+            Traction(lambda x: np.isclose(x[:, 1], 1.0), s_n),
+        ],
     )
     assert _max_nodal_error(res) < 1e-10
 
 
-def test_bad_boundary_name_raises():
+def test_physical_groups_and_facet_tags_name_the_same_parts():
+    with unit_square_model(0.25) as model:
+        sides = ("left", "bottom", "right", "top")
+        by_name = solve_plane_strain(model, E_PATCH, NU_PATCH, [Displacement(sides[0], u_lin_bc),
+                                                                Displacement(sides[1], u_lin_bc),
+                                                                Traction(sides[2], s_n), Traction(sides[3], s_n)])
+        tag = [by_name.physical_groups[name].tag for name in sides]
+        by_tag = solve_plane_strain(model, E_PATCH, NU_PATCH, [Displacement(tag[0], u_lin_bc),
+                                                               Displacement(tag[1], u_lin_bc),
+                                                               Traction(tag[2], s_n), Traction(tag[3], s_n)])
+    assert np.array_equal(by_name.u.x.array, by_tag.u.x.array)
+    assert _max_nodal_error(by_name) < 1e-10
+
+
+def test_outward_normals_on_a_hole():
+    """The facets of a circular hole: outward (into the hole) normals of unit length, from the
+    nearest facet, and the cells next to the part."""
+    from rkfx.cases.plate_with_hole import mesh_plate
+
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        if MPI.COMM_WORLD.rank == 0:
+            mesh_plate(1.0, 4.0, 0.5)
+        res = solve_plane_strain(gmsh.model, E_PATCH, NU_PATCH, [Displacement("left", 0.0, (0,)),
+                                                                 Displacement("bottom", 0.0, (1,))])
+    finally:
+        gmsh.finalize()
+    parts = BoundaryParts(res.mesh, res.facet_tags, res.physical_groups)
+    x = res.mesh.geometry.x[:, :2]
+    r = np.linalg.norm(x, axis=1)
+    on_hole = x[np.abs(r - 1.0) < 1e-9]
+    if len(parts.facets("hole")):
+        n = parts.normals("hole", on_hole * 1.001)
+        assert np.allclose(np.linalg.norm(n, axis=1), 1.0)
+        assert np.all(np.einsum("ij,ij->i", n, -on_hole) > 0.99)  # facets of ~0.17 rad: cos > 0.996
+        assert len(parts.cells("hole")) >= len(parts.facets("hole"))
+    top = parts.normals("top", np.array([[2.0, 4.0]]))
+    assert top.shape == (1, 2)
+    if len(parts.facets("top")):
+        assert np.array_equal(top, [[0.0, 1.0]])
+
+
+def test_bad_conditions_raise():
     with unit_square_model(0.5) as model:
-        with pytest.raises(KeyError, match="nowhere"):
-            solve_plane_strain(model, 1.0, 0.3, dirichlet={"nowhere": u_lin})
+        with pytest.raises(InputError, match="no boundary part 'nowhere'.*physical group"):
+            solve_plane_strain(model, 1.0, 0.3, [Displacement("nowhere", u_lin_bc)])
+        with pytest.raises(InputError, match="takes no Pressure"):
+            solve_plane_strain(model, 1.0, 0.3, [Displacement("left"), Pressure("right")])
+        with pytest.raises(InputError, match="share facets"):
+            solve_plane_strain(model, 1.0, 0.3, [Displacement("left"), Traction("top", 1.0),
+                                                 Traction(lambda x: x[:, 1] > 0.5, 2.0)])
+        with pytest.raises(InputError, match="facet tag 999"):
+            solve_plane_strain(model, 1.0, 0.3, [Displacement(999)])
 
 
 # --- assembly timing -----------------------------------------------------------

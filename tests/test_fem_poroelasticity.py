@@ -22,6 +22,8 @@ import numpy as np  # noqa: E402
 from scipy.optimize import brentq  # noqa: E402
 
 from fem_baselines import poroelasticity as pe  # noqa: E402
+from rkfx.conditions import Displacement, Flux, Pressure, Traction, Velocity  # noqa: E402
+from rkfx.errors import InputError  # noqa: E402
 
 # --------------------------------------------------------------------------- Terzaghi
 # The seed's column (Wei 2018, sec. 3.4.1): E = 1 kPa, nu = 0, k_h = 1e-5 m/s, gamma_f = 10 kN/m^3
@@ -35,12 +37,11 @@ AWAY = T_YS <= T_H - 1.0  # outside the drained top's boundary layer
 
 def terzaghi_bcs() -> list:
     return [
-        pe.Displacement("bottom", 0, 0.0),
-        pe.Displacement("bottom", 1, 0.0),
-        pe.Displacement("left", 0, 0.0),
-        pe.Displacement("right", 0, 0.0),
-        pe.Traction("top", (0.0, -T_Q)),
-        pe.Pressure("top", 0.0),
+        Displacement("bottom"),
+        Displacement("left", 0.0, (0,)),
+        Displacement("right", 0.0, (0,)),
+        Traction("top", (0.0, -T_Q)),
+        Pressure("top"),
     ]
 
 
@@ -143,14 +144,10 @@ def test_steady_flux_and_pressure_data(element, form):
     nu > 0, alpha < 1: the long-time limit is p = p_top + q_in (H - z) / k exactly."""
     E, nu, k, alpha, S, q_in, p_top = 1e3, 0.2, 1e-9, 0.9, 1e-4, 1e-7, 500.0
     ys = np.linspace(0.0, T_H, 21)
-    bcs = [
-        pe.Displacement("bottom", 0, 0.0),
-        pe.Displacement("bottom", 1, 0.0),
-        pe.Displacement("left", 0, 0.0),
-        pe.Displacement("right", 0, 0.0),
-        pe.Traction("top", lambda x, t: np.vstack([0 * x[0], np.full(x.shape[1], -100.0)])),
-        pe.Pressure("top", lambda x, t: np.full(x.shape[1], p_top)),
-        pe.Flux("bottom", -q_in),  # outward normal flux < 0: inflow
+    bcs = terzaghi_bcs()[:3] + [
+        Traction("top", lambda x, t, n: np.column_stack([0 * x[:, 0], np.full(len(x), -100.0)])),
+        Pressure("top", lambda x, t: np.full(len(x), p_top)),
+        Flux("bottom", -q_in),  # outward normal flux < 0: inflow
     ]
     times = np.r_[0.0, np.cumsum(1e3 * 1.3 ** np.arange(60))]  # to T_v ~ 230
     cell = "triangle" if element == "taylor-hood" else "quadrilateral"
@@ -168,7 +165,7 @@ def test_uniform_pressure_state_is_preserved(element, form):
     data through the FPP projection term (without it the error is ~1e3 Pa)."""
     alpha, p_c = 0.9, 500.0
     ys = np.geomspace(1.0, T_H + 1.0, 21) - 1.0  # graded: eps_f varies per cell
-    bcs = terzaghi_bcs()[:4] + [pe.Traction("top", (0.0, -alpha * p_c)), pe.Pressure("top", p_c)]
+    bcs = terzaghi_bcs()[:3] + [Traction("top", (0.0, -alpha * p_c)), Pressure("top", p_c)]
     times = np.r_[0.0, np.cumsum(1.5 ** np.arange(10))]
     cell = "triangle" if element == "taylor-hood" else "quadrilateral"
     mesh = pe.rectangle_mesh(T_XS, ys, cell)
@@ -177,6 +174,20 @@ def test_uniform_pressure_state_is_preserved(element, form):
                         fpp_form=form, initial_p=lambda x: np.full(x.shape[1], p_c))
     assert np.abs(res.p - p_c).max() < 1e-8 * p_c  # measured <= 4e-11 Pa
     assert np.abs(res.u).max() < 1e-10
+
+
+def test_conditions_of_normals_and_of_components_equal_the_constants():
+    """A traction -q n from the facet normals, and the bottom's two components given one by one,
+    give the run of the constant traction and Displacement("bottom") exactly."""
+    times = np.array([0.0, 1.0, 3.0])
+    mesh = pe.rectangle_mesh(T_XS, T_YS[:9], "triangle")
+    args = (mesh, T_E, T_NU, T_K, T_ALPHA, 0.0, "taylor-hood")
+    a = pe.solve_biot(*args, terzaghi_bcs(), times, T_POINTS[:9], times[1:])
+    bcs = [Displacement("bottom", 0.0, (0,)), Displacement("bottom", 0.0, (1,))] + terzaghi_bcs()[1:3] + [
+        Traction("top", lambda x, t, n: -T_Q * n), Pressure("top")]
+    b = pe.solve_biot(*args, bcs, times, T_POINTS[:9], times[1:])
+    assert np.array_equal(a.p, b.p) and np.array_equal(a.u, b.u)
+    assert a.p[0].max() > 0.5 * T_Q
 
 
 class _Stop(Exception):
@@ -192,12 +203,12 @@ def test_resumed_run_equals_an_uninterrupted_one(tmp_path, element, form):
     out = times[[1, 6, 12]]
 
     def bcs(stop_after=np.inf):
-        def load(x, t):
+        def load(x, t, n):
             if t > stop_after:
                 raise _Stop
-            return np.vstack([0 * x[0], np.full(x.shape[1], -T_Q * min(1.0, t / times[3]))])
+            return np.column_stack([0 * x[:, 0], np.full(len(x), -T_Q * min(1.0, t / times[3]))])
 
-        return terzaghi_bcs()[:4] + [pe.Traction("top", load), pe.Pressure("top", 0.0)]
+        return terzaghi_bcs()[:3] + [Traction("top", load), Pressure("top")]
 
     cell = "triangle" if element == "taylor-hood" else "quadrilateral"
     mesh = pe.rectangle_mesh(T_XS, T_YS, cell)
@@ -254,10 +265,10 @@ def mandel_uy_top(t: float) -> float:
 
 def mandel_bcs() -> list:
     return [
-        pe.Displacement("left", 0, 0.0),
-        pe.Displacement("bottom", 1, 0.0),
-        pe.Displacement("top", 1, lambda x, t: np.full(x.shape[1], mandel_uy_top(t))),
-        pe.Pressure("right", 0.0),
+        Displacement("left", 0.0, (0,)),
+        Displacement("bottom", 0.0, (1,)),
+        Displacement("top", lambda x, t: np.full(len(x), mandel_uy_top(t)), (1,)),
+        Pressure("right"),
     ]
 
 
@@ -374,8 +385,22 @@ def test_bad_input():
         pe.solve_biot(*args, "q1q1", terzaghi_bcs(), [0.0, 1.0], T_POINTS, [0.5])
     with pytest.raises(ValueError, match="increasing"):
         pe.solve_biot(*args, "q1q1", terzaghi_bcs(), [0.0, 0.0], T_POINTS, [0.0])
-    with pytest.raises(ValueError, match="boundary"):
-        pe.solve_biot(*args, "q1q1", [pe.Pressure("middle", 0.0)], [0.0, 1.0], T_POINTS, [1.0])
+    with pytest.raises(InputError, match="no boundary part 'middle'"):
+        pe.solve_biot(*args, "q1q1", [Pressure("middle")], [0.0, 1.0], T_POINTS, [1.0])
+    with pytest.raises(InputError, match="no boundary part 'middle'"):
+        pe.solve_biot(*args, "q1q1", terzaghi_bcs() + [Flux("middle", 1.0)], [0.0, 1.0], T_POINTS, [1.0])
+    with pytest.raises(InputError, match="no facets"):
+        pe.solve_biot(*args, "q1q1", [Pressure(lambda x: x[:, 0] > 2.0)], [0.0, 1.0], T_POINTS, [1.0])
+    with pytest.raises(InputError, match="returned shape"):
+        pe.solve_biot(*args, "q1q1", [Pressure(lambda x: x[:, :1] > 0.5)], [0.0, 1.0], T_POINTS, [1.0])
+    with pytest.raises(InputError, match="takes no Velocity"):
+        pe.solve_biot(*args, "q1q1", [Velocity("bottom")], [0.0, 1.0], T_POINTS, [1.0])
+    with pytest.raises(InputError, match="components"):
+        pe.solve_biot(*args, "q1q1", [Displacement("bottom", 0.0, (2,))], [0.0, 1.0], T_POINTS, [1.0])
+    with pytest.raises(InputError, match="share facets"):
+        pe.solve_biot(*args, "q1q1", terzaghi_bcs() + [Traction("top", 1.0)], [0.0, 1.0], T_POINTS, [1.0])
+    with pytest.raises(InputError, match="not a boundary condition"):
+        pe.solve_biot(*args, "q1q1", [("bottom", 0, 0.0)], [0.0, 1.0], T_POINTS, [1.0])
     with pytest.raises(ValueError, match="increasing"):
         pe.rectangle_mesh([0.0, 1.0, 0.5], T_YS)
 

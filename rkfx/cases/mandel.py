@@ -50,9 +50,10 @@ import numpy as np
 
 from verification.mandel import Mandel
 
+from rkfx.conditions import Displacement, Pressure, split
 from rkfx.errors import InputError
 from rkfx.geometry.particles import structured
-from rkfx.models.poroelasticity import VARIANTS, Displacement, PoroMaterial, Pressure, solve_biot, time_grid, zero
+from rkfx.models.poroelasticity import VARIANTS, PoroMaterial, solve_biot, time_grid, zero
 from rkfx.cases import _cli
 from rkfx.cases._cli import Param, Results, Run
 
@@ -106,24 +107,27 @@ def _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F):
         raise InputError("F = 0: the problem has no load")
 
 
-def _rkpm(p, material, exact, times, outputs, variant, support_factor, desc, io):
-    bcs_u = [Displacement("left", zero, (0,)), Displacement("bottom", zero, (1,)),
-             Displacement("top", lambda x, t: np.full(len(x), exact.plate_displacement(t)), (1,))]
-    bcs_p = [Pressure("right", lambda x, t: np.zeros(len(x)))]
-    sol = solve_biot(p, material, times, outputs, bcs_u, bcs_p, variant=variant, support_factor=support_factor,
-                     progress=lambda it: _cli.progress(it, desc, len(times) - 1), **io)
+def _conditions(exact):
+    """The quarter model's boundary conditions, the same for RKPM and FEM: symmetry rollers left and
+    bottom, the rigid plate's displacement on top, drained right side."""
+    return [Displacement("left", zero, (0,)), Displacement("bottom", zero, (1,)),
+            Displacement("top", lambda x, t: np.full(len(x), exact.plate_displacement(t)), (1,)),
+            Pressure("right", lambda x, t: np.zeros(len(x)))]
+
+
+def _rkpm(p, material, bcs, times, outputs, variant, support_factor, desc, io):
+    kinds = split(bcs)
+    sol = solve_biot(p, material, times, outputs, kinds[Displacement], kinds[Pressure], variant=variant,
+                     support_factor=support_factor, progress=lambda it: _cli.progress(it, desc, len(times) - 1), **io)
     return sol, sol.pressure, sol.wall_time_s, sol.n_dofs
 
 
-def _fem(xs, ys, material, exact, times, outputs, element, samples, io):
+def _fem(xs, ys, material, bcs, times, outputs, element, samples, io):
     import dolfinx_solver  # noqa: F401, PLC0415
 
     from fem_baselines import poroelasticity as fb  # noqa: PLC0415
 
     mesh = fb.rectangle_mesh(xs, ys, "triangle" if element == "taylor-hood" else "quadrilateral")
-    bcs = [fb.Displacement("left", 0, 0.0), fb.Displacement("bottom", 1, 0.0),
-           fb.Displacement("top", 1, lambda x, t: np.full(x.shape[1], exact.plate_displacement(t))),
-           fb.Pressure("right", 0.0)]
     res = fb.solve_biot(mesh, material.E, material.nu, material.k, material.alpha, material.S, element, bcs,
                         times, samples, outputs, **io)
     return res.p, res.wall_time_s, res.n_dofs
@@ -152,16 +156,17 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, 
                   support_factor=support_factor, c=c, p0=p0, h=h, steps=len(times) - 1)
     results = Results(NAME, params)
     ck = _cli.Checkpoints(checkpoint_every, work_dir, resume)
+    bcs = _conditions(exact)
     solvers = []
     if "rkpm" in methods:
         for v in dict.fromkeys(list(variants) + list(early_variants)):
             solvers.append((f"rkpm-{v}", v in variants, v in early_variants,
-                            lambda tt, out, key, v=v: _rkpm(particles, material, exact, tt, out, v, support_factor,
+                            lambda tt, out, key, v=v: _rkpm(particles, material, bcs, tt, out, v, support_factor,
                                                             f"rkpm {v}", ck.for_run(key))))
     if "fem" in methods:
         for e in fem:
             def fem_solve(tt, out, key, e=e):
-                pp, wall, dofs = _fem(xs, ys, material, exact, tt, out, e, samples, ck.for_run(key))
+                pp, wall, dofs = _fem(xs, ys, material, bcs, tt, out, e, samples, ck.for_run(key))
                 return None, (lambda pts, pp=pp: pp), wall, dofs
             solvers.append((f"fem-{e}", True, True, fem_solve))
     for label, profiles, early, solve in solvers:

@@ -209,9 +209,10 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E: float = 1.0e3, nu: float
     rk_bcs = ([Dirichlet("left", lambda x: np.zeros(len(x)), (0,)),
                Dirichlet("bottom", lambda x: np.zeros(len(x)), (1,))],
               [Traction("right", exact.traction), Traction("top", exact.traction)])
-    fem_bcs = ({"left": (0, 0.0), "bottom": (1, 0.0)},
-               {"right": lambda x: exact.traction(x.T, np.tile([1.0, 0.0], (x.shape[1], 1))).T,
-                "top": lambda x: exact.traction(x.T, np.tile([0.0, 1.0], (x.shape[1], 1))).T})
+    from rkfx import conditions as fem_conditions  # noqa: PLC0415
+    fem_bcs = [fem_conditions.Displacement("left", 0.0, (0,)), fem_conditions.Displacement("bottom", 0.0, (1,)),
+               fem_conditions.Traction("right", lambda x, t, n: exact.traction(x, n)),
+               fem_conditions.Traction("top", lambda x, t, n: exact.traction(x, n))]
     try:
         for lev in _cli.progress(range(levels), desc=NAME):
             hl = h / 2**lev
@@ -231,7 +232,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E: float = 1.0e3, nu: float
                     sxx_axis = _stress_xx(sol.gradient(points), material)
                     u_h = sol.displacement(p.x)
                 else:
-                    res = fem.solve_plane_strain(gmsh.model, E, nu, *fem_bcs, degree=int(label[5:]), comm=comm)
+                    res = fem.solve_plane_strain(gmsh.model, E, nu, fem_bcs, degree=int(label[5:]), comm=comm)
                     wall, n_dofs = res.wall_time_s, res.n_dofs
                     e = fem.errors(res, lambda X: ufl.as_vector(exact.displacement_xy(X[0], X[1], ufl.sqrt)))
                     errors = {"l2": e["l2"], "h1": e["h1"]}

@@ -47,10 +47,10 @@ import numpy as np
 
 from verification.terzaghi import Terzaghi
 
+from rkfx.conditions import Displacement, Pressure, Traction, split
 from rkfx.errors import InputError
 from rkfx.geometry.particles import structured
-from rkfx.models.poroelasticity import (VARIANTS, Displacement, PoroMaterial, Pressure, Traction, solve_biot,
-                              time_grid, zero)
+from rkfx.models.poroelasticity import VARIANTS, PoroMaterial, solve_biot, time_grid, zero
 from rkfx.cases import _cli
 from rkfx.cases._cli import Param, Results, Run
 
@@ -107,14 +107,15 @@ def _check(W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny):
 
 def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_factor, io):
     """Pressure at the samples for each output time, wall time and unknowns."""
+    # Fixed bottom, rollers on the sides, the load q on the drained top: for RKPM and FEM alike.
+    bcs = [Displacement("bottom", zero), Displacement("left", zero, (0,)), Displacement("right", zero, (0,)),
+           Pressure("top", lambda x, t: np.zeros(len(x))),
+           Traction("top", lambda x, t, n: np.tile([0.0, -q], (len(x), 1)))]
     if method.startswith("rkpm-"):
         p = structured(W, H, nx, ny)
-        sol = solve_biot(p, material, times, outputs,
-                         displacements=[Displacement("bottom", zero), Displacement("left", zero, (0,)),
-                                        Displacement("right", zero, (0,))],
-                         pressures=[Pressure("top", lambda x, t: np.zeros(len(x)))],
-                         tractions=[Traction("top", lambda x, t, n: np.tile([0.0, -q], (len(x), 1)))],
-                         variant=method[5:], support_factor=support_factor,
+        kinds = split(bcs)
+        sol = solve_biot(p, material, times, outputs, displacements=kinds[Displacement], pressures=kinds[Pressure],
+                         tractions=kinds[Traction], variant=method[5:], support_factor=support_factor,
                          progress=lambda it: _cli.progress(it, method, len(times) - 1), **io)
         return sol.pressure(samples), sol.wall_time_s, sol.n_dofs
     import dolfinx_solver  # noqa: F401, PLC0415
@@ -124,8 +125,6 @@ def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_f
     element = method[4:]
     mesh = fb.rectangle_mesh(np.linspace(0, W, nx), np.linspace(0, H, ny),
                              "triangle" if element == "taylor-hood" else "quadrilateral")
-    bcs = [fb.Displacement("bottom", 0, 0.0), fb.Displacement("bottom", 1, 0.0), fb.Displacement("left", 0, 0.0),
-           fb.Displacement("right", 0, 0.0), fb.Traction("top", np.array([0.0, -q])), fb.Pressure("top", 0.0)]
     res = fb.solve_biot(mesh, material.E, material.nu, material.k, material.alpha, material.S, element, bcs,
                         times, samples, outputs, **io)
     return res.p, res.wall_time_s, res.n_dofs

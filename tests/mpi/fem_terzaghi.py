@@ -12,6 +12,7 @@ import numpy as np  # noqa: E402
 from mpi4py import MPI  # noqa: E402
 
 from fem_baselines import poroelasticity as pe  # noqa: E402
+from rkfx.conditions import Displacement, Pressure, Traction  # noqa: E402
 
 
 def main(out: str) -> None:
@@ -19,12 +20,11 @@ def main(out: str) -> None:
     xs = np.linspace(0.0, 1.0, 3)
     ys = np.linspace(0.0, 10.0, 21)
     bcs = [
-        pe.Displacement("bottom", 0, 0.0),
-        pe.Displacement("bottom", 1, 0.0),
-        pe.Displacement("left", 0, 0.0),
-        pe.Displacement("right", 0, 0.0),
-        pe.Traction("top", (0.0, -q)),
-        pe.Pressure("top", 0.0),
+        Displacement("bottom"),
+        Displacement("left", 0.0, (0,)),
+        Displacement("right", 0.0, (0,)),
+        Traction("top", lambda x, t, n: -q * n),  # the normal of the top facets: (0, 1)
+        Pressure("top"),
     ]
     times = np.r_[0.0, np.cumsum(1e4 * 1.5 ** np.arange(12))]
     pts = np.column_stack([np.full(len(ys), 0.25), ys])
