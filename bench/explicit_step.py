@@ -27,7 +27,7 @@ KALTHOFF_T, KALTHOFF_NODES, IMPACT_V = 80e-6, 202_500, 16.5
 
 
 def measure(num_nodes: int, steps: int, courant: float) -> dict:
-    from rkfx.assembly.boundary import Dirichlet
+    from rkfx.conditions import Displacement, Velocity
     from rkfx.materials.elasticity import ElasticMaterial
     from rkfx.assembly.smeared_strain import constraint, elastic_force, lumped_mass, smeared_strain, stable_time_step
     from rkfx.solvers.central_difference import ExplicitDynamics, run_explicit
@@ -44,9 +44,8 @@ def measure(num_nodes: int, steps: int, courant: float) -> dict:
     op = smeared_strain(p, rk, dom)
     f_int = elastic_force(op, mat.D())
     mass = lumped_mass(dom.area, RHO)
-    roller = constraint(p, rk, [Dirichlet("bottom", lambda x: np.zeros(len(x)), (1,))])
-    impact = constraint(p, rk, [Dirichlet("left", lambda x: np.where(x[:, 1] < 0.5 * SIDE, IMPACT_V, 0.0), (0,))],
-                        kind="velocity")
+    roller = constraint(p, rk, [Displacement("bottom", 0.0, (1,))])
+    impact = constraint(p, rk, [Velocity("left", lambda x, t: np.where(x[:, 1] < 0.5 * SIDE, IMPACT_V, 0.0), (0,))])
     dt = stable_time_step(p.spacing, mat, RHO, courant)
     problem = ExplicitDynamics(mass, f_int, dt, constraints=[roller, impact])
     setup = time.perf_counter() - t0

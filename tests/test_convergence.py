@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from conftest import unit_square
-from rkfx.assembly.boundary import Dirichlet
+from rkfx.conditions import Displacement
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.models.elastostatics import solve_plane_strain
 from rkfx.integration.norms import relative_errors
@@ -24,7 +24,7 @@ def study(rule, bc_method="nitsche", support_factor=1.5):
     rows = []
     for h in SIZES:
         p = unit_square(h)
-        bcs = [Dirichlet(s, FIELD.displacement) for s in p.boundary_names]
+        bcs = [Displacement(s, lambda x, t: FIELD.displacement(x)) for s in p.boundary_names]
         sol = solve_plane_strain(p, MATERIAL, bcs, body_force=FIELD.body_force, rule=rule, bc_method=bc_method,
                                  support_factor=support_factor)
         err = relative_errors(p, sol.rk, sol.coefficients, FIELD.displacement, FIELD.gradient)

@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from rkfx.assembly.boundary import Dirichlet, Traction, boundary_quadrature, traction_load
+from rkfx.assembly.boundary import boundary_quadrature, traction_load
+from rkfx.conditions import Displacement, Traction, Velocity
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.errors import InputError
 from rkfx.assembly.smeared_strain import (constraint, dilatational_wave_speed, elastic_force, lumped_mass, max_frequency,
@@ -105,8 +106,7 @@ def _bar(nx=101, ny=5, length=1.0, height=0.04):
     p = structured(length, height, nx, ny)
     mat = ElasticMaterial(1.0, 0.0)
     rk, dom, op, m, f_int = setup(p, mat)
-    zero = lambda x: np.zeros(len(x))  # noqa: E731
-    rollers = constraint(p, rk, [Dirichlet("bottom", zero, (1,)), Dirichlet("top", zero, (1,))])
+    rollers = constraint(p, rk, [Displacement("bottom", 0.0, (1,)), Displacement("top", 0.0, (1,))])
     return p, mat, rk, dom, m, f_int, rollers
 
 
@@ -123,11 +123,11 @@ def test_pulse_travels_at_the_bar_wave_speed(drive):
     dt = stable_time_step(p.spacing, mat, 1.0)
     v0 = 1e-3  # particle velocity behind the front
     if drive == "velocity":
-        push = constraint(p, rk, [Dirichlet("left", lambda x: np.full(len(x), v0), (0,))], kind="velocity")
+        push = constraint(p, rk, [Velocity("left", v0, (0,))])
         problem = ExplicitDynamics(m, f_int, dt, constraints=[rollers, push])
     else:  # a suddenly applied pressure rho c v0 on the left end
         f = traction_load(p, boundary_quadrature(p, dom, rk),
-                          [Traction("left", lambda x, n: np.tile([c * v0, 0.0], (len(x), 1)))])
+                          [Traction("left", (c * v0, 0.0))])
         problem = ExplicitDynamics(m, f_int, dt, external_force=lambda t: f, constraints=[rollers])
     probes = np.array([[0.25, 0.02], [0.75, 0.02], [1.0, 0.02]])
     n_probe = evaluate(rk, probes).matrix(0)
@@ -150,7 +150,7 @@ def test_free_vibration_conserves_energy():
     p = structured(1.0, 1.0, 17, 17)
     mat = ElasticMaterial(1.0, 0.25)
     rk, dom, op, m, f_int = setup(p, mat)
-    clamp = constraint(p, rk, [Dirichlet("left", lambda x: np.zeros((len(x), 2)))])
+    clamp = constraint(p, rk, [Displacement("left", 0.0)])
     dt = stable_time_step(p.spacing, mat, 1.0)
     x, y = p.x[:, 0], p.x[:, 1]
     v0 = np.column_stack([0.01 * np.sin(np.pi * y) * x, 0.02 * x**2]).ravel()
@@ -180,8 +180,8 @@ def test_checkpoint_resume_reaches_the_identical_state(tmp_path):
     p = structured(1.0, 0.5, 13, 7)
     mat = ElasticMaterial(1.0, 0.3)
     rk = rk_approximation(p.x, p.spacing)
-    clamp = constraint(p, rk, [Dirichlet("left", lambda x: np.zeros((len(x), 2)))])
-    pull = constraint(p, rk, [Dirichlet("right", lambda x: np.full(len(x), 0.05), (0,))], kind="velocity")
+    clamp = constraint(p, rk, [Displacement("left", 0.0)])
+    pull = constraint(p, rk, [Velocity("right", 0.05, (0,))])
     dt = stable_time_step(p.spacing, mat, 1.0)
     n_steps = 60
 
@@ -227,15 +227,16 @@ def test_prescribed_displacement_history_is_met_exactly():
     mat = ElasticMaterial(1.0, 0.2)
     rk, dom, op, m, f_int = setup(p, mat)
     dt = stable_time_step(p.spacing, mat, 1.0)
-    g = constraint(p, rk, [Dirichlet("left", lambda x: np.zeros((len(x), 2))),
-                           Dirichlet("right", lambda x: np.full(len(x), 1e-3), (0,))],
-                   amplitude=lambda t: np.sin(2.0 * t))
+    g = constraint(p, rk, [Displacement("left", 0.0),
+                           Displacement("right", lambda x, t: np.full(len(x), 1e-3 * np.sin(2.0 * t)), (0,))])
     snaps = run_explicit(ExplicitDynamics(m, f_int, dt, constraints=[g]), 150, output_every=50).snapshots
     for step, t, d, v in snaps:
         assert np.abs(g.G @ d - g.displacement(t)).max() <= 1e-15
         assert np.abs(g.G @ v - 2e-3 * np.cos(2.0 * t) * (g.displacement(1.0) != 0)).max() < 1e-6
-    with pytest.raises(InputError, match="kind"):
-        constraint(p, rk, [], kind="acceleration")
+    with pytest.raises(InputError, match="all of one kind, got Displacement, Velocity; build one"):
+        constraint(p, rk, [Displacement("left", 0.0), Velocity("right", 1.0, (0,))])
+    with pytest.raises(InputError, match="Displacement or Velocity conditions, all of one kind, got Traction"):
+        constraint(p, rk, [Traction("right", (1.0, 0.0))])
     dep = Constraint(g.G[[0, 0]])
     with pytest.raises(InputError, match="dependent"):
         run_explicit(ExplicitDynamics(m, f_int, dt, constraints=[dep]), 1)

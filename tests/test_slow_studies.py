@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from conftest import l_shape
-from rkfx.assembly.boundary import Dirichlet
+from rkfx.conditions import Displacement
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.models.elastostatics import solve_plane_strain
 from rkfx.integration.norms import relative_errors
@@ -20,7 +20,7 @@ def test_rates_on_the_l_shape_over_five_levels(rule, support_factor):
     h, l2, h1 = [], [], []
     for size in (0.2, 0.1, 0.05, 0.025, 0.0125):
         p = l_shape(size)
-        bcs = [Dirichlet(s, field.displacement) for s in p.boundary_names]
+        bcs = [Displacement(s, lambda x, t: field.displacement(x)) for s in p.boundary_names]
         sol = solve_plane_strain(p, material, bcs, body_force=field.body_force, rule=rule,
                                  support_factor=support_factor)
         err = relative_errors(p, sol.rk, sol.coefficients, field.displacement, field.gradient)

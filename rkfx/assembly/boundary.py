@@ -1,23 +1,33 @@
 """Boundary integration, loads and essential boundary conditions for RK approximations.
 
+The conditions are those of ``rkfx.conditions`` (``Displacement``, ``Velocity``, ``Pressure``,
+``Traction``, ``Flux``), evaluated with ``rkfx.conditions.values``: a constant, a constant
+vector or a function value(x, t) (value(x, t, n) for tractions, with the boundary normals).
+A condition's boundary part is a name (a tagged part of the particles) or a marker
+``marker(x) -> bool (m,)``; ``part_nodes`` and ``part_points`` resolve it, to the nodes of the
+part (a name's nodes, or the boundary nodes the marker accepts) and to the boundary quadrature
+points of the part (by tag, or the points the marker accepts).
+
 RK shape functions do not interpolate nodal values, so u = u_bar on Gamma_u needs care:
 
 * ``transformation`` — the mixed transformation method: u^h(x_I) = u_bar(x_I) at every node
   I on Gamma_u. Writing the transformed system back in the RK coefficients gives the
   collocation constraints G d = g with G_IJ = N_J(x_I), imposed by multipliers:
-  [[K, G^T], [G, 0]] [d, lambda] = [f, g].
+  [[K, G^T], [G, 0]] [d, lambda] = [f, g] (``collocation``, ``transformation_constraints``).
 * ``nitsche`` — symmetric Nitsche: adds -int(eta.t(u) + t(eta).u) + beta int(eta.u) on
   Gamma_u, with beta = penalty (lambda + 2 mu) / h. Evaluated at the midpoints of the
   boundary half-segments, the same points SCNI's divergence form uses, so the linear
-  patch test is passed to round-off.
+  patch test is passed to round-off (``nitsche_terms``).
+
+Tractions load f_I = int_Gamma_t N_I t_bar dGamma at the same points (``traction_load``).
 """
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 
-from rkfx.conditions import ESSENTIAL, values
+from rkfx.conditions import ESSENTIAL, Boundary, Condition, Displacement, Traction, values
 from rkfx.errors import InputError
 from rkfx.geometry.nodal_domains import NodalDomains
 from rkfx.geometry.particles import Particles
@@ -25,36 +35,6 @@ from rkfx.approximation.shape_functions import RKApproximation, evaluate
 from rkfx.approximation.sparse_rows import SparseRows
 
 BC_METHODS = ("transformation", "nitsche")
-
-
-@dataclass(frozen=True)
-class Dirichlet:
-    """Prescribed displacement on a named boundary part.
-
-    Attributes:
-        boundary: Boundary part name.
-        value: u_bar(x) for x of shape ``(m, 2)`` [m], returning ``(m, 2)`` (or ``(m,)`` when
-            one component is prescribed).
-        components: Prescribed components: ``(0, 1)``, ``(0,)`` or ``(1,)``.
-    """
-
-    boundary: str
-    value: Callable[[np.ndarray], np.ndarray]
-    components: tuple[int, ...] = (0, 1)
-
-    def values_at(self, x: np.ndarray) -> np.ndarray:
-        """Prescribed values at x, shape ``(m, len(components))``."""
-        v = np.asarray(self.value(x), float)
-        return v.reshape(len(x), -1)[:, list(self.components)] if v.ndim == 2 and v.shape[1] == 2 \
-            else v.reshape(len(x), len(self.components))
-
-
-@dataclass(frozen=True)
-class Traction:
-    """Prescribed traction t_bar(x, n) [Pa] on a named boundary part (``(m, 2)`` arrays in and out)."""
-
-    boundary: str
-    value: Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 
 @dataclass(frozen=True)
@@ -96,19 +76,85 @@ def boundary_quadrature(p: Particles, domains: NodalDomains, rk: RKApproximation
         rows=evaluate(rk, pts, gradients=True))
 
 
-def _restrict(rows: SparseRows, mask: np.ndarray) -> sp.csr_matrix:
-    """Value matrix of the selected rows."""
-    return rows.matrix(0)[np.flatnonzero(mask)]
+def _only(conditions: Sequence[Condition], kinds: tuple[type, ...], where: str) -> Sequence[Condition]:
+    """The conditions, if each is one of ``kinds``; else a one-line error naming the culprit."""
+    for c in conditions:
+        if not isinstance(c, kinds):
+            names = " or ".join(f"rkfx.conditions.{k.__name__}" for k in kinds)
+            raise InputError(f"{where} takes {names} conditions, not {c!r}")
+    return conditions
 
 
-def traction_load(p: Particles, bq: BoundaryQuadrature, tractions: Sequence[Traction]) -> np.ndarray:
-    """f_I = int_Gamma_t N_I t_bar dGamma (eq. 3.36), interleaved, shape ``(2 n,)``."""
+def _part_label(boundary: Boundary) -> str:
+    return repr(boundary) if isinstance(boundary, str) else f"marker {getattr(boundary, '__name__', repr(boundary))}"
+
+
+def _marked(boundary: Boundary, x: np.ndarray, what: str) -> np.ndarray:
+    """The marker's answer at points x, shape ``(m,)`` bool; raises if it selects none."""
+    accepted = np.asarray(boundary(x))
+    if accepted.shape != (len(x),):
+        raise InputError(f"boundary {_part_label(boundary)} returned shape {accepted.shape} for {len(x)} points; "
+                         "a marker(x) takes x of shape (m, 2) and returns a bool array of shape (m,)")
+    accepted = accepted.astype(bool)
+    if not accepted.any():
+        raise InputError(f"boundary {_part_label(boundary)} selects no {what}; make it accept points on the "
+                         "boundary (e.g. np.isclose(x[:, 1], top)), or name a tagged part")
+    return accepted
+
+
+def _tag(p: Particles, boundary: Boundary) -> int:
+    """The tag of a named part, with the fix in the message for anything else."""
+    if not isinstance(boundary, str):
+        raise InputError(f"boundary part {boundary!r} is neither a name nor a marker; use the name of a tagged "
+                         "part or a function marker(x) -> bool (m,)")
+    if boundary not in p.boundary_names:
+        raise InputError(f"unknown boundary {boundary!r}; this geometry names {sorted(p.boundary_names)}: use one "
+                         "of them or a marker(x) -> bool (m,)")
+    return p.boundary_names[boundary]
+
+
+def part_nodes(p: Particles, boundary: Boundary) -> np.ndarray:
+    """Sorted indices of the nodes of a boundary part: the nodes of a named part, or the
+    boundary nodes whose coordinates a marker accepts."""
+    if callable(boundary):
+        nodes = p.boundary_nodes()
+        return nodes[_marked(boundary, p.x[nodes], "boundary node")]
+    _tag(p, boundary)
+    return p.boundary_nodes(boundary)
+
+
+def part_points(p: Particles, bq: BoundaryQuadrature, boundary: Boundary) -> np.ndarray:
+    """Indices of the boundary quadrature points of a part: those with the part's tag, or those
+    a marker accepts."""
+    if callable(boundary):
+        return np.flatnonzero(_marked(boundary, bq.points, "boundary quadrature point"))
+    return np.flatnonzero(bq.select([_tag(p, boundary)]))
+
+
+def traction_load(p: Particles, bq: BoundaryQuadrature, tractions: Sequence[Traction],
+                  t: float = 0.0) -> np.ndarray:
+    """f_I = int_Gamma_t N_I t_bar dGamma (eq. 3.36) at time t, interleaved, shape ``(2 n,)``.
+
+    Args:
+        tractions: ``rkfx.conditions.Traction`` conditions; value(x, t, n) is evaluated at the
+            boundary quadrature points of each part with their outward normals. Components
+            not listed carry no traction.
+        t: Time [s].
+    """
     f = np.zeros((p.num_nodes, 2))
-    for t in tractions:
-        sel = bq.select([p.tag(t.boundary)])
-        tv = np.asarray(t.value(bq.points[sel], bq.normals[sel]), float).reshape(-1, 2)
-        f += _restrict(bq.rows, sel).T @ (bq.weights[sel, None] * tv)
+    nmat = bq.rows.matrix(0)
+    for tr in _only(tractions, (Traction,), "traction_load"):
+        sel = part_points(p, bq, tr.boundary)
+        f += nmat[sel].T @ (bq.weights[sel, None] * traction_values(tr, bq, sel, t))
     return f.ravel()
+
+
+def traction_values(traction: Traction, bq: BoundaryQuadrature, sel: np.ndarray, t: float = 0.0) -> np.ndarray:
+    """t_bar(x, t, n) at the boundary quadrature points ``sel`` (indices), shape ``(len(sel), 2)``:
+    zero in the components the traction does not list."""
+    tv = np.zeros((len(sel), 2))
+    tv[:, list(traction.components)] = values(traction, bq.points[sel], t, bq.normals[sel])
+    return tv
 
 
 @dataclass(frozen=True)
@@ -124,20 +170,10 @@ class Collocation:
     G: sp.csr_matrix
     parts: list
 
-    def values(self, x: np.ndarray, *args) -> np.ndarray:
-        """Prescribed values, shape ``(k,)``: ``condition.value(x_I, *args)`` per block.
-
-        A value function may return every component ``(m, num_components)`` (the prescribed
-        component is taken), only the prescribed ones ``(m, len(components))``, or ``(m,)``.
-        """
-        out = []
-        for bc, j, c, nodes, ncomp in self.parts:
-            if isinstance(bc, ESSENTIAL):  # rkfx.conditions: values of (x, t), constants
-                out.append(values(bc, x[nodes], *args)[:, j])
-                continue
-            v = np.asarray(bc.value(x[nodes], *args), float).reshape(len(nodes), -1)
-            col = c if (v.shape[1] == ncomp and ncomp > 1) else (j if v.shape[1] > 1 else 0)
-            out.append(v[:, col])
+    def values(self, x: np.ndarray, t: float = 0.0) -> np.ndarray:
+        """Prescribed values g at time t, shape ``(k,)``: ``rkfx.conditions.values`` of each
+        condition at its nodes x_I, the column of the block's component."""
+        out = [values(bc, x[nodes], t)[:, j] for bc, j, _, nodes, _ in self.parts]
         return np.concatenate(out) if out else np.zeros(0)
 
 
@@ -146,17 +182,18 @@ def collocation(p: Particles, rk: RKApproximation, fields: Sequence[tuple[Sequen
     """Collocation rows for the conditions of several fields of one problem.
 
     Args:
-        fields: ``(conditions, offset, num_components)`` per field: each condition has
-            ``boundary``, ``value`` and (for vector fields) ``components``; the field's unknowns
-            start at ``offset`` and are interleaved per node. A (node, component) pair already
-            prescribed by an earlier condition is not prescribed again.
+        fields: ``(conditions, offset, num_components)`` per field: essential conditions of
+            ``rkfx.conditions`` (``Displacement``, ``Velocity``, ``Pressure``) collocated at the
+            nodes of their parts (``part_nodes``); the field's unknowns start at ``offset`` and
+            are interleaved per node. A (node, component) pair already prescribed by an earlier
+            condition is not prescribed again.
         num_unknowns: Columns of G.
     """
     blocks, parts, seen = [], [], set()
     for conditions, offset, ncomp in fields:
-        for bc in conditions:
-            nodes = p.boundary_nodes(bc.boundary)
-            for j, c in enumerate(getattr(bc, "components", (0,))):
+        for bc in _only(conditions, ESSENTIAL, "collocation"):
+            nodes = part_nodes(p, bc.boundary)
+            for j, c in enumerate(bc.components):
                 fresh = np.array([(offset, c, i) not in seen for i in nodes], bool)
                 seen.update((offset, c, i) for i in nodes)
                 sel = nodes[fresh]
@@ -170,16 +207,26 @@ def collocation(p: Particles, rk: RKApproximation, fields: Sequence[tuple[Sequen
     return Collocation(g, parts)
 
 
-def transformation_constraints(p: Particles, rk: RKApproximation,
-                               dirichlet: Sequence[Dirichlet]) -> tuple[sp.csr_matrix, np.ndarray]:
-    """Rows G (k, 2n) and values g (k,) of u^h_c(x_I) = u_bar_c(x_I) at the nodes of Gamma_u."""
-    col = collocation(p, rk, [(dirichlet, 0, 2)], 2 * p.num_nodes)
-    return col.G, col.values(p.x)
+def transformation_constraints(p: Particles, rk: RKApproximation, conditions: Sequence[Condition],
+                               t: float = 0.0) -> tuple[sp.csr_matrix, np.ndarray]:
+    """Rows G (k, 2n) and values g (k,) at time t of u^h_c(x_I) = u_bar_c(x_I, t) at the nodes
+    of Gamma_u, for essential conditions of ``rkfx.conditions`` on the displacement field (or
+    its velocity, ``Velocity``)."""
+    col = collocation(p, rk, [(conditions, 0, 2)], 2 * p.num_nodes)
+    return col.G, col.values(p.x, t)
 
 
-def nitsche_terms(p: Particles, bq: BoundaryQuadrature, d: np.ndarray, dirichlet: Sequence[Dirichlet],
-                  penalty: float = 100.0) -> tuple[sp.csr_matrix, np.ndarray]:
-    """Symmetric Nitsche matrix (2n, 2n) and load (2n,) for the prescribed components."""
+def nitsche_terms(p: Particles, bq: BoundaryQuadrature, d: np.ndarray, conditions: Sequence[Displacement],
+                  penalty: float = 100.0, t: float = 0.0) -> tuple[sp.csr_matrix, np.ndarray]:
+    """Symmetric Nitsche matrix (2n, 2n) and load (2n,) for the prescribed components.
+
+    Args:
+        d: Elasticity matrix (3, 3) [Pa].
+        conditions: ``rkfx.conditions.Displacement`` conditions, value(x, t) evaluated at the
+            boundary quadrature points of each part (``part_points``).
+        penalty: Dimensionless Nitsche parameter.
+        t: Time [s].
+    """
     if not penalty > 0:
         raise InputError(f"Nitsche penalty = {penalty!r} must be positive (e.g. 100)")
     from rkfx.materials.elasticity import traction_operator  # noqa: PLC0415
@@ -190,8 +237,8 @@ def nitsche_terms(p: Particles, bq: BoundaryQuadrature, d: np.ndarray, dirichlet
     f_total = np.zeros(n2)
     grad = SparseRows(bq.rows.indptr, bq.rows.indices, bq.rows.data[:, 1:], bq.rows.num_cols)
     b_all = strain_matrix(grad)
-    for bc in dirichlet:
-        sel = np.flatnonzero(bq.select([p.tag(bc.boundary)]))
+    for bc in _only(conditions, (Displacement,), "nitsche_terms"):
+        sel = part_points(p, bq, bc.boundary)
         if sel.size == 0:
             continue
         m = len(sel)
@@ -210,6 +257,6 @@ def nitsche_terms(p: Particles, bq: BoundaryQuadrature, d: np.ndarray, dirichlet
         beta = penalty * d[0, 0] / np.tile(bq.spacing[sel], len(comps))
         wmat = sp.diags(wc)
         k_total = k_total - proj.T @ wmat @ trac - trac.T @ wmat @ proj + proj.T @ sp.diags(wc * beta) @ proj
-        ubar = bc.values_at(bq.points[sel]).T.ravel()
+        ubar = values(bc, bq.points[sel], t).T.ravel()
         f_total += -trac.T @ (wc * ubar) + proj.T @ (wc * beta * ubar)
     return k_total.tocsr(), f_total

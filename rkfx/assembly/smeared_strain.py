@@ -9,11 +9,11 @@ f_int = B~^T Sigma(B~ d) V (eqs. 4.31-4.34) with B~ the smeared strain operator 
 stresses (``rkfx.models.damage_dynamics``).
 
 Essential conditions are collocation rows G (u^h(x_I) = g(t) at boundary nodes, as in
-``rkfx.assembly.boundary``) built by ``constraint``; a prescribed velocity (e.g. an impact) is one
-kind of them. The central-difference stepper that advances these models, imposes the
-conditions by projection and keeps the energies and checkpoints is
-``rkfx.solvers.central_difference`` (``CentralDifference``; ``run_explicit`` for a problem
-of callables).
+``rkfx.assembly.boundary``) built by ``constraint`` from ``rkfx.conditions.Displacement`` or
+``Velocity`` conditions (a prescribed velocity, e.g. an impact). The central-difference
+stepper that advances these models, imposes the conditions by projection and keeps the
+energies and checkpoints is ``rkfx.solvers.central_difference`` (``CentralDifference``;
+``run_explicit`` for a problem of callables).
 
 Stable step (CFL): dt = C min(h_I) / c_d, c_d = sqrt((lambda + 2 mu) / rho) (plane strain),
 C = 0.5 by default; ``max_frequency`` measures omega_max for the exact bound dt < 2/omega_max
@@ -28,7 +28,8 @@ import numba
 import numpy as np
 import scipy.sparse as sp
 
-from rkfx.assembly.boundary import Dirichlet, transformation_constraints
+from rkfx.assembly.boundary import collocation
+from rkfx.conditions import Displacement, Velocity
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.errors import InputError
 from rkfx.geometry.nodal_domains import NodalDomains, nodal_domains
@@ -371,22 +372,28 @@ def max_frequency(mass: np.ndarray, internal_force: Callable[[np.ndarray], np.nd
     return float(np.sqrt(max(lam, 0.0)))
 
 
-def constraint(p: Particles, rk: RKApproximation, dirichlet: Sequence[Dirichlet],
-               amplitude: Callable[[float], float] | None = None, kind: str = "displacement") -> Constraint:
-    """Collocation conditions u^h(x_I) = a(t) u_bar(x_I) at the nodes of the named boundaries,
-    as essential conditions of the central-difference stepper (``rkfx.solvers.central_difference``).
+def constraint(p: Particles, rk: RKApproximation, conditions: Sequence[Displacement | Velocity]) -> Constraint:
+    """Collocation conditions u^h(x_I) = u_bar(x_I, t) (or du^h/dt(x_I) = v_bar(x_I, t)) at the
+    nodes of the conditions' boundary parts, as essential conditions of the central-difference
+    stepper (``rkfx.solvers.central_difference``).
 
     Args:
-        dirichlet: Conditions as for the static solvers; ``value`` gives u_bar(x) (a
-            displacement [m], or a velocity [m/s] with ``kind="velocity"``).
-        amplitude: Time factor a(t) (default 1).
-        kind: ``displacement`` or ``velocity``.
+        conditions: ``rkfx.conditions.Displacement`` [m] or ``rkfx.conditions.Velocity`` [m/s]
+            conditions, all of one kind (build one constraint per kind). Constant values are
+            evaluated once, and a displacement constraint with only zeros is homogeneous
+            (``displacement=None``); function values value(x, t) are evaluated at the boundary
+            nodes each time the stepper asks for g(t).
     """
-    if kind not in ("displacement", "velocity"):
-        raise InputError(f"kind = {kind!r}: choose 'displacement' or 'velocity'")
-    g, values = transformation_constraints(p, rk, dirichlet)
-    amp = amplitude or (lambda t: 1.0)
-    homogeneous = amplitude is None and not np.any(values)
-    f = None if homogeneous else (lambda t: amp(t) * values)
-    return Constraint(g, displacement=f) if kind == "displacement" else \
-        Constraint(g, velocity=f or (lambda t: values))
+    kinds = {type(c) for c in conditions}
+    if not kinds <= {Displacement, Velocity} or len(kinds) > 1:
+        raise InputError(f"constraint takes rkfx.conditions.Displacement or Velocity conditions, all of one kind, "
+                         f"got {', '.join(sorted(k.__name__ for k in kinds))}; build one constraint per kind")
+    velocity = Velocity in kinds
+    col = collocation(p, rk, [(conditions, 0, 2)], 2 * p.num_nodes)
+    if any(callable(c.value) for c in conditions):
+        g = lambda t: col.values(p.x, t)  # noqa: E731
+    else:
+        constant = col.values(p.x)
+        homogeneous = not velocity and not np.any(constant)
+        g = None if homogeneous else lambda t: constant  # noqa: E731
+    return Constraint(col.G, velocity=g) if velocity else Constraint(col.G, displacement=g)

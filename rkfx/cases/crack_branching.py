@@ -60,7 +60,8 @@ from pathlib import Path
 import numpy as np
 
 from rkfx.fracture import damage as dm
-from rkfx.assembly.boundary import Traction, boundary_quadrature, traction_load
+from rkfx.assembly.boundary import boundary_quadrature, traction_load
+from rkfx.conditions import Traction
 from rkfx.fracture.tracking import tracking
 from rkfx.errors import InputError
 from rkfx.models.damage_dynamics import DamageRun
@@ -134,7 +135,7 @@ def _check(E, nu, rho, ft, GF, sigma, plane, t_end, tol, hs, support_factor, cou
 def traction_force(pl: dyn.Plate, sigma: float) -> np.ndarray:
     """f_I = int N_I sigma n dGamma over the top and bottom edges (SCNI's midpoint rule), shape (2 n,)."""
     bq = boundary_quadrature(pl.p, pl.domains, pl.rk)
-    pull = lambda x, n: sigma * n  # noqa: E731 - t = sigma n: +y on top, -y on bottom
+    pull = lambda x, t, n: sigma * n  # noqa: E731 - t = sigma n: +y on top, -y on bottom
     return traction_load(pl.p, bq, [Traction("top", pull), Traction("bottom", pull)])
 
 

@@ -60,7 +60,7 @@ from pathlib import Path
 import numpy as np
 
 from rkfx.fracture import damage as dm
-from rkfx.assembly.boundary import Dirichlet
+from rkfx.conditions import Displacement, Velocity
 from rkfx.fracture.tracking import tracking
 from rkfx.errors import InputError
 from rkfx.assembly.smeared_strain import constraint
@@ -121,9 +121,8 @@ def _check(E, nu, rho, ft, GF, v0, t_end, tol, nodes, support_factor, courant, r
 
 def model_conditions(pl: dyn.Plate, v0: float):
     """The roller on y = 0 and the impact velocity on the left edge below the crack."""
-    roller = constraint(pl.p, pl.rk, [Dirichlet("bottom", lambda x: np.zeros(len(x)), (1,))])
-    impact = constraint(pl.p, pl.rk, [Dirichlet("left", lambda x: np.where(x[:, 1] < A2, v0, 0.0), (0,))],
-                        kind="velocity")
+    roller = constraint(pl.p, pl.rk, [Displacement("bottom", 0.0, (1,))])
+    impact = constraint(pl.p, pl.rk, [Velocity("left", lambda x, t: np.where(x[:, 1] < A2, v0, 0.0), (0,))])
     return [roller, impact]
 
 

@@ -42,7 +42,8 @@ import numpy as np
 
 from verification.kirsch import Kirsch
 
-from rkfx.assembly.boundary import BC_METHODS, Dirichlet, Traction
+from rkfx.assembly.boundary import BC_METHODS
+from rkfx.conditions import Displacement, Traction
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.models.elastostatics import solve_plane_strain
 from rkfx.errors import InputError
@@ -206,9 +207,8 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E: float = 1.0e3, nu: float
 
     y_axis = a + (L - a) * np.linspace(0.0, 1.0, NUM_PROFILE) ** 2  # clustered at the hole
     axis = np.column_stack([np.zeros_like(y_axis), y_axis])
-    rk_bcs = ([Dirichlet("left", lambda x: np.zeros(len(x)), (0,)),
-               Dirichlet("bottom", lambda x: np.zeros(len(x)), (1,))],
-              [Traction("right", exact.traction), Traction("top", exact.traction)])
+    rk_bcs = [Displacement("left", 0.0, (0,)), Displacement("bottom", 0.0, (1,)),
+              *(Traction(side, lambda x, t, n: exact.traction(x, n)) for side in ("right", "top"))]
     from rkfx import conditions as fem_conditions  # noqa: PLC0415
     fem_bcs = [fem_conditions.Displacement("left", 0.0, (0,)), fem_conditions.Displacement("bottom", 0.0, (1,)),
                fem_conditions.Traction("right", lambda x, t, n: exact.traction(x, n)),
@@ -223,7 +223,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E: float = 1.0e3, nu: float
             for label in labels:
                 if label.startswith("rkpm"):
                     t0 = time.perf_counter()
-                    sol = solve_plane_strain(p, material, *rk_bcs, rule=label[5:], bc_method=bc_method,
+                    sol = solve_plane_strain(p, material, rk_bcs, rule=label[5:], bc_method=bc_method,
                                              support_factor=support_factor, comm=comm)
                     wall, n_dofs = time.perf_counter() - t0, sol.n_dofs
                     errors = relative_errors(p, sol.rk, sol.coefficients, exact.displacement,

@@ -19,7 +19,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from rkfx.fracture import damage as dm
-from rkfx.assembly.boundary import Dirichlet, transformation_constraints
+from rkfx.assembly.boundary import transformation_constraints
+from rkfx.conditions import Displacement
 from rkfx.errors import InputError
 from rkfx.geometry.grid_cells import grid_domains
 from rkfx.linalg.linear_solver import linear_solver
@@ -117,13 +118,10 @@ def gauss_strip(L: float, A: float, n: int, support_factor: float = 1.5) -> Stri
 
 
 def _with_constraints(p, rk, b, points, volume, extent, geometry, h, A) -> Strip:
-    def const(value):
-        return lambda x: np.full(len(x), value)
-
-    bcs = [Dirichlet("right", const(1.0), (0,)), Dirichlet("left", const(0.0), (0,)),
-           Dirichlet("left", const(0.0), (1,)), Dirichlet("right", const(0.0), (1,))]
+    bcs = [Displacement("right", 1.0, (0,)), Displacement("left", 0.0, (0,)),
+           Displacement("left", 0.0, (1,)), Displacement("right", 0.0, (1,))]
     g, g_unit = transformation_constraints(p, rk, bcs)
-    right = np.arange(len(p.boundary_nodes("right")))  # the first Dirichlet's rows
+    right = np.arange(len(p.boundary_nodes("right")))  # the first condition's rows
     return Strip(p, rk, b, points, volume, extent, geometry, g, g_unit, right, h, A / h)
 
 

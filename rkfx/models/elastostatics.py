@@ -1,4 +1,8 @@
-"""Plane-strain elastostatics with RK shape functions: assemble, constrain, solve through PETSc."""
+"""Plane-strain elastostatics with RK shape functions: assemble, constrain, solve through PETSc.
+
+The boundary conditions are those of ``rkfx.conditions``: ``Displacement`` (imposed by Nitsche's
+method or the transformation method, ``rkfx.assembly.boundary``) and ``Traction``.
+"""
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -6,8 +10,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from rkfx.assembly.boundary import (BC_METHODS, Dirichlet, Traction, boundary_quadrature, nitsche_terms, traction_load,
-                       transformation_constraints)
+from rkfx.assembly.boundary import (BC_METHODS, boundary_quadrature, nitsche_terms, traction_load,
+                                    transformation_constraints)
+from rkfx.conditions import Condition, Displacement, Traction, split
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.linalg.linear_solver import linear_solver
 from rkfx.errors import InputError
@@ -44,9 +49,8 @@ class ElasticSolution:
         return np.stack([rows.matrix(1) @ self.coefficients, rows.matrix(2) @ self.coefficients], axis=2)
 
 
-def solve_plane_strain(p: Particles, material: ElasticMaterial, dirichlet: Sequence[Dirichlet],
-                       tractions: Sequence[Traction] = (),
-                       body_force: Callable[[np.ndarray], np.ndarray] | None = None,
+def solve_plane_strain(p: Particles, material: ElasticMaterial, conditions: Sequence[Displacement | Traction] = (),
+                       *, body_force: Callable[[np.ndarray], np.ndarray] | None = None,
                        rule: str = "mscni", bc_method: str = "nitsche", support_factor: float = 1.5,
                        order: int = 1, nitsche_penalty: float = 100.0, comm=None,
                        solver: str = "mumps") -> ElasticSolution:
@@ -55,8 +59,10 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, dirichlet: Seque
     Args:
         p: Particles with named boundary parts.
         material: Elastic constants.
-        dirichlet: Prescribed displacements.
-        tractions: Prescribed tractions.
+        conditions: The boundary conditions, one list of ``rkfx.conditions.Displacement``
+            (prescribed displacements, value(x, t) at t = 0 or a constant) and
+            ``rkfx.conditions.Traction`` (value(x, t, n) at t = 0 or a constant vector) on
+            named or marked boundary parts; the rest of the boundary is traction-free.
         body_force: b(x) [N/m^3] for x of shape ``(m, 2)``, returning ``(m, 2)``.
         rule: Integration rule: ``gauss1|gauss2|gauss4|dni|scni|mscni``.
         bc_method: ``transformation`` or ``nitsche``.
@@ -65,6 +71,7 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, dirichlet: Seque
         comm: MPI communicator for the PETSc solve (default COMM_WORLD).
         solver: ``mumps`` | ``gmres-ilu`` | ``cg-gamg``.
     """
+    displacements, tractions = _displacements_and_tractions(conditions)
     if bc_method not in BC_METHODS:
         raise InputError(f"unknown bc_method {bc_method!r}; choose one of {', '.join(BC_METHODS)}")
     times = {}
@@ -81,10 +88,10 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, dirichlet: Seque
         f += load_vector(q.values, q.weights, body_force(q.points))
     times["assemble"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    g, gv = transformation_constraints(p, rk, dirichlet)
+    g, gv = transformation_constraints(p, rk, displacements)
     _check_rigid_modes(p, g)
     if bc_method == "nitsche":
-        kn, fn = nitsche_terms(p, bq, d, dirichlet, nitsche_penalty)
+        kn, fn = nitsche_terms(p, bq, d, displacements, nitsche_penalty)
         system, rhs = k + kn, f + fn
     else:
         system = sp.bmat([[k, g.T], [g, None]], format="csr")
@@ -94,6 +101,18 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, dirichlet: Seque
     ls.destroy()
     times["solve"] = time.perf_counter() - t0
     return ElasticSolution(rk, x[:2 * p.num_nodes].reshape(-1, 2), 2 * p.num_nodes, times)
+
+
+def _displacements_and_tractions(conditions: Sequence[Condition]) -> tuple[list, list]:
+    """The Displacement and Traction conditions of ``conditions``; any other kind raises."""
+    if isinstance(conditions, Displacement | Traction):
+        conditions = [conditions]
+    by_kind = split(conditions)
+    other = [c for kind, cs in by_kind.items() if kind not in (Displacement, Traction) for c in cs]
+    if other:
+        raise InputError(f"solve_plane_strain takes rkfx.conditions.Displacement and Traction conditions, not "
+                         f"{other[0]!r}; drop it (a Velocity belongs to explicit dynamics: smeared_strain.constraint)")
+    return by_kind[Displacement], by_kind[Traction]
 
 
 def _check_rigid_modes(p: Particles, g: sp.csr_matrix) -> None:

@@ -34,7 +34,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from rkfx.assembly.boundary import Collocation, boundary_quadrature, collocation
+from rkfx.assembly.boundary import (Collocation, boundary_quadrature, collocation, part_points,
+                                   traction_values)
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.conditions import Displacement, Flux, Pressure, Traction, values
 from rkfx.errors import InputError
@@ -432,17 +433,16 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
     timings["assemble"] = time.perf_counter() - t0
     t0 = time.perf_counter()
 
+    traction_points = [part_points(p, bq, tr.boundary) for tr in tractions]
+    flux_points = [part_points(p, bq, fl.boundary) for fl in fluxes]
+
     def loads(t):
         f = np.zeros((n, 2))
-        for tr in tractions:
-            sel = bq.select([p.tag(tr.boundary)])
-            f += nb[np.flatnonzero(sel)].T @ (bq.weights[sel, None]
-                                               * values(tr, bq.points[sel], t, bq.normals[sel]))
+        for tr, sel in zip(tractions, traction_points):
+            f += nb[sel].T @ (bq.weights[sel, None] * traction_values(tr, bq, sel, t))
         q = np.zeros(n)
-        for fl in fluxes:
-            sel = bq.select([p.tag(fl.boundary)])
-            q -= nb[np.flatnonzero(sel)].T @ (bq.weights[sel]
-                                               * values(fl, bq.points[sel], t, bq.normals[sel])[:, 0])
+        for fl, sel in zip(fluxes, flux_points):
+            q -= nb[sel].T @ (bq.weights[sel] * values(fl, bq.points[sel], t, bq.normals[sel])[:, 0])
         return f.ravel() + f_gravity, q + q_gravity  # F^ext (3.36) and Q^ext (3.37)
 
     model = BiotModel(ops, material, col, p.x, loads)

@@ -133,7 +133,11 @@ def _energy_increments(v, mass, dd, f_int0, f_int1, f_ext0, f_ext1, dv):
 
 @dataclass(frozen=True)
 class Constraint:
-    """Essential conditions G d = g(t) on the unknowns (collocation rows, or unit rows).
+    """Essential conditions G d = g(t) on the unknowns: the stepper's algebraic form of them.
+
+    Built from ``rkfx.conditions`` (``Displacement`` or ``Velocity``) by
+    ``rkfx.assembly.smeared_strain.constraint`` (collocation rows at boundary nodes), or from
+    unit rows for nodal unknowns.
 
     Attributes:
         G: Rows over the unknowns of the model's layout, shape ``(k, size)``.

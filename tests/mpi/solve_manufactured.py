@@ -10,7 +10,7 @@ import gmsh
 import numpy as np
 from mpi4py import MPI
 
-from rkfx.assembly.boundary import Dirichlet
+from rkfx.conditions import Displacement
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.models.elastostatics import solve_plane_strain
 from rkfx.geometry.gmsh_nodes import from_gmsh
@@ -33,7 +33,7 @@ if comm.rank == 0:
     gmsh.finalize()
 material = ElasticMaterial(1.0, 0.3)
 field = SineField(material.lame_lambda, material.shear_modulus)
-sol = solve_plane_strain(p, material, [Dirichlet("boundary", field.displacement)], body_force=field.body_force,
-                         rule="mscni", bc_method="transformation", comm=comm)
+sol = solve_plane_strain(p, material, [Displacement("boundary", lambda x, t: field.displacement(x))],
+                         body_force=field.body_force, rule="mscni", bc_method="transformation", comm=comm)
 if comm.rank == 0:
     np.save(sys.argv[1], sol.coefficients)
