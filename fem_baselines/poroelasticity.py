@@ -83,8 +83,7 @@ from rkfx.linalg.linear_solver import Factorizations
 from rkfx.models.poroelasticity import PoroMaterial, fpp_parameter
 from rkfx.solvers.fields import Field, FieldLayout
 from rkfx.solvers.integrate import integrate
-from rkfx.solvers.model import Constraints
-from rkfx.solvers.model import step_key
+from rkfx.solvers.model import Constraints, PerStepSize
 from rkfx.solvers.newmark import StepState, backward_euler
 
 __all__ = [
@@ -328,7 +327,7 @@ class FemBiotModel:
         self._t = float(t0)  # committed time (the seed form's step starts there)
         self._t_trial = self._t
         self._at: dict[str, tuple[float, Any]] = {}  # loads and constraints at the last t
-        self._per_dt: dict[tuple[str, float], Any] = {}
+        self._per_step = PerStepSize(keep=4)
 
     def _assemble(self, mesh: dolfinx.mesh.Mesh) -> None:
         """K, C without FPP, and what FPP needs per step size."""
@@ -457,14 +456,6 @@ class FemBiotModel:
 
     # ------------------------------------------------------------------ matrices
 
-    def _memo(self, what: str, dt: float, build):
-        key = (what, step_key(dt))
-        if key not in self._per_dt:
-            if len(self._per_dt) > 8:
-                self._per_dt.pop(next(iter(self._per_dt)))
-            self._per_dt[key] = build(dt)
-        return self._per_dt[key]
-
     def stabilization(self, dt: float) -> sp.csr_matrix:
         """The FPP matrix S = M_eps - C diag(eps_f / |K|) C^T for steps of dt, shape ``(n_p, n_p)``."""
         def build(dt):
@@ -474,7 +465,7 @@ class FemBiotModel:
             projection = self._ct.T @ sp.diags(eps / self._cell_area_global) @ self._ct
             return (_global_matrix(self._m_eps, self.comm) - projection).tocsr()
 
-        return self._memo("fpp", dt, build)
+        return self._per_step.get("fpp", dt, build)
 
     def _on_pressure(self, a: sp.csr_matrix) -> sp.csr_matrix:
         """A p-p block as a matrix over all unknowns."""
@@ -485,7 +476,7 @@ class FemBiotModel:
     def tangent(self, x: np.ndarray, t: float) -> sp.csr_matrix:
         if not self.seed:
             return self._K
-        return self._memo("K", t - self._t, lambda dt: self._K + self._on_pressure(self.stabilization(dt)))
+        return self._per_step.get("K", t - self._t, lambda dt: self._K + self._on_pressure(self.stabilization(dt)))
 
     def residual(self, x: np.ndarray, t: float) -> np.ndarray:
         self._t_trial = t
@@ -497,11 +488,11 @@ class FemBiotModel:
     def capacity(self, dt: float) -> sp.csr_matrix:
         if not self.fpp or self.seed:
             return self._C
-        return self._memo("C", dt, lambda dt: self._C + self._on_pressure(self.stabilization(dt)))
+        return self._per_step.get("C", dt, lambda dt: self._C + self._on_pressure(self.stabilization(dt)))
 
     def equation_weights(self, co) -> np.ndarray:
         """-1 / (dp'/dp) on the storage rows: the symmetric Jacobian of eq. 3.43."""
-        return self._memo("W", co.dt, lambda dt: np.r_[np.ones(self._n_u),
+        return self._per_step.get("W", co.dt, lambda dt: np.r_[np.ones(self._n_u),
                                                        np.full(self.layout.size - self._n_u, -1.0 / co.dv[-1])])
 
     # ------------------------------------------------------------------ history

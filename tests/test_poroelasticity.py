@@ -5,15 +5,16 @@ import pytest
 from rkfx.errors import InputError
 from rkfx.geometry.nodal_domains import nodal_domains
 from rkfx.geometry.particles import structured
-from rkfx.models.poroelasticity import (Displacement, Flux, NodalFields, PoroMaterial, Pressure, biot_operators, fpp_parameter,
-                                 solve_biot, time_grid, zero)
+from rkfx.conditions import Displacement, Flux, Pressure
+from rkfx.models.poroelasticity import NodalFields, PoroMaterial, biot_operators, fpp_parameter, solve_biot
+from rkfx.solvers.integrate import time_grid
 from rkfx.approximation.shape_functions import rk_approximation
 
 H = 4.0
 MATERIAL = PoroMaterial(E=1.0e6, nu=0.25, k=1.0e-6)
 COLUMN = structured(1.0, H, 5, 17)
-FIXED = [Displacement("bottom", zero), Displacement("left", zero, (0,)), Displacement("right", zero, (0,))]
-DRAINED_TOP = [Pressure("top", lambda x, t: np.zeros(len(x)))]
+FIXED = [Displacement("bottom"), Displacement("left", components=(0,)), Displacement("right", components=(0,))]
+DRAINED_TOP = [Pressure("top")]
 AXIS = np.column_stack([np.full(9, 0.5), np.linspace(0.0, H, 9)])
 LONG = time_grid([1.0e8], 10.0, 2.0, hold=2)  # to steady state
 

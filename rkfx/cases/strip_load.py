@@ -50,7 +50,8 @@ from verification.strip_load import StripLoad
 from rkfx.conditions import Displacement, Pressure, Traction, split
 from rkfx.errors import InputError
 from rkfx.geometry.particles import graded
-from rkfx.models.poroelasticity import VARIANTS, PoroMaterial, solve_biot, time_grid, zero
+from rkfx.models.poroelasticity import VARIANTS, PoroMaterial, solve_biot
+from rkfx.solvers.integrate import time_grid
 from rkfx.cases import _cli
 from rkfx.cases._cli import Param, Results, Run
 
@@ -120,8 +121,8 @@ def _check(nx, ny, dt_D, t_D_profile, t_D_end, extent, b, q, steps_low, variants
 def _solve(method, xs, ys, material, q, b, times, outputs, samples, drained, support_factor, io):
     """Pressure (k, m) and displacement (k, m, 2) at the samples, wall time, unknowns."""
     # Fixed bottom, rollers on the sides, the surface drained or not: for RKPM and FEM alike.
-    held = [Displacement("bottom", zero), Displacement("left", zero, (0,)), Displacement("right", zero, (0,))]
-    held += [Pressure("top", lambda x, t: np.zeros(len(x)))] if drained else []
+    held = [Displacement("bottom"), Displacement("left", components=(0,)), Displacement("right", components=(0,))]
+    held += [Pressure("top")] if drained else []
     if method.startswith("rkpm-"):
         p = graded(xs, ys)
         load = Traction("top", lambda x, t, n: np.column_stack([0 * x[:, 0], -q * (x[:, 0] <= b + 1e-12 * b)]))

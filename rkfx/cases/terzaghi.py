@@ -50,7 +50,8 @@ from verification.terzaghi import Terzaghi
 from rkfx.conditions import Displacement, Pressure, Traction, split
 from rkfx.errors import InputError
 from rkfx.geometry.particles import structured
-from rkfx.models.poroelasticity import VARIANTS, PoroMaterial, solve_biot, time_grid, zero
+from rkfx.models.poroelasticity import VARIANTS, PoroMaterial, solve_biot
+from rkfx.solvers.integrate import time_grid
 from rkfx.cases import _cli
 from rkfx.cases._cli import Param, Results, Run
 
@@ -108,8 +109,8 @@ def _check(W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny):
 def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_factor, io):
     """Pressure at the samples for each output time, wall time and unknowns."""
     # Fixed bottom, rollers on the sides, the load q on the drained top: for RKPM and FEM alike.
-    bcs = [Displacement("bottom", zero), Displacement("left", zero, (0,)), Displacement("right", zero, (0,)),
-           Pressure("top", lambda x, t: np.zeros(len(x))),
+    bcs = [Displacement("bottom"), Displacement("left", components=(0,)), Displacement("right", components=(0,)),
+           Pressure("top"),
            Traction("top", lambda x, t, n: np.tile([0.0, -q], (len(x), 1)))]
     if method.startswith("rkpm-"):
         p = structured(W, H, nx, ny)

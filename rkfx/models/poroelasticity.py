@@ -45,7 +45,7 @@ from rkfx.geometry.particles import Particles
 from rkfx.integration.quadrature import Quadrature, dni, mscni_stabilization, scni, smoothed_gradients
 from rkfx.approximation.shape_functions import RKApproximation, evaluate, rk_approximation
 from rkfx.solvers.fields import layout
-from rkfx.solvers.integrate import integrate, time_grid  # noqa: F401  (time_grid: part of this module's API)
+from rkfx.solvers.integrate import integrate
 from rkfx.solvers.model import Constraints, PerStepSize, Stateless
 from rkfx.solvers.newmark import backward_euler
 from rkfx.approximation.sparse_rows import SparseRows, combine_rows
@@ -246,11 +246,6 @@ def biot_operators(p: Particles, rk: RKApproximation, domains: NodalDomains, mat
 
 # Boundary conditions: the core's vocabulary (``rkfx.conditions``); a traction of the u-p
 # model is the total traction (sigma'' - alpha p I) n.
-def zero(x: np.ndarray, t: float, *_) -> np.ndarray:
-    """Homogeneous value for any boundary condition."""
-    return np.zeros((len(x), 2))
-
-
 @dataclass
 class BiotSolution:
     """Nodal coefficients at the output times and the approximation to evaluate them.
