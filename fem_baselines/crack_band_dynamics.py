@@ -82,7 +82,7 @@ from rkfx.errors import InputError
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.assembly.smeared_strain import dilatational_wave_speed
 from rkfx.models.damage_dynamics import DamageRun, run_damage, run_key
-from rkfx.ranks import on_root
+from rkfx.parallel.ranks import on_root
 from rkfx.solvers.central_difference import Constraint
 
 __all__ = [

@@ -34,9 +34,10 @@ data path (see docs/core.md):
         damage_dynamics  the damage particle method in explicit dynamics, runs kept on disk
     solvers         fields, the model protocol, steppers, one Newton, checkpoints
     linalg          linear solves: factorizations through PETSc (``rkfx.linalg.petsc``) or SciPy
+    parallel        work over MPI ranks
+        ranks            serial work under MPI: rank 0 runs it, every rank gets the result
     conditions      boundary conditions: one vocabulary, values of x and t
     errors          errors naming the culprit and the fix
-    ranks           serial work under MPI: rank 0 runs it, every rank gets the result
     warmup          compile the kernels before timing
 
 ``rkfx.linalg.petsc`` (imported on purpose) hands the sparse operators to PETSc;

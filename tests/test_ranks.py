@@ -1,7 +1,7 @@
-"""Serial work under MPI (rkfx.ranks): rank 0 runs it, every rank gets the result or the error."""
+"""Serial work under MPI (rkfx.parallel.ranks): rank 0 runs it, every rank gets the result or the error."""
 import pytest
 
-from rkfx.ranks import on_root
+from rkfx.parallel.ranks import on_root
 
 
 class _TwoRanks:

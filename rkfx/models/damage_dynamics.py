@@ -58,7 +58,7 @@ from rkfx.fracture.tracking import Tracking
 from rkfx.fracture.damage import DamageModel, crack_opening, dissipation_density, initiate
 from rkfx.materials.damage_law import damage_kernel, strain_kernel
 from rkfx.errors import InputError
-from rkfx.ranks import on_root
+from rkfx.parallel.ranks import on_root
 from rkfx.solvers.central_difference import CentralDifference, Constraint, ExplicitDynamics, ExplicitState
 from rkfx.solvers.checkpoint import copy_into
 

@@ -1,0 +1,1 @@
+"""Work over MPI ranks: ownership of particles, ghost exchange, and serial work under MPI."""
