@@ -35,6 +35,9 @@ data path (see docs/core.md):
     solvers         fields, the model protocol, steppers, one Newton, checkpoints
     linalg          linear solves: factorizations through PETSc (``rkfx.linalg.petsc``) or SciPy
     parallel        work over MPI ranks
+        partition        recursive coordinate bisection of the nodes into parts
+        ownership        a rank's owned nodes and ghosts, the numbering with contiguous parts
+        rows             a rank's contributions sent to the owners of their rows
         ranks            serial work under MPI: rank 0 runs it, every rank gets the result
     conditions      boundary conditions: one vocabulary, values of x and t
     errors          errors naming the culprit and the fix

@@ -61,8 +61,14 @@ class BoundaryQuadrature:
 
 
 def boundary_quadrature(p: Particles, domains: NodalDomains, rk: RKApproximation,
-                        points_per_segment: int = 1) -> BoundaryQuadrature:
-    """Gauss-Legendre points on every boundary half-segment (1 point = SCNI's midpoint rule)."""
+                        points_per_segment: int = 1, segments: np.ndarray | None = None) -> BoundaryQuadrature:
+    """Gauss-Legendre points on every boundary half-segment (1 point = SCNI's midpoint rule).
+
+    ``segments`` (indices of boundary half-segments, e.g. those of a rank's owned nodes) keeps
+    every point but gives shape rows and weights only to the points of those segments; the
+    others get empty rows and zero weight, so boundary parts are still resolved on the whole
+    boundary and the loads and Nitsche terms sum to the whole ones over a partition.
+    """
     if points_per_segment < 1:
         raise InputError(f"points_per_segment = {points_per_segment!r} must be >= 1")
     b = domains.boundary
@@ -70,10 +76,21 @@ def boundary_quadrature(p: Particles, domains: NodalDomains, rk: RKApproximation
     t = 0.5 * (s + 1.0)
     pts = (b.ends[:, None, 0] * (1 - t)[None, :, None] + b.ends[:, None, 1] * t[None, :, None]).reshape(-1, 2)
     k = points_per_segment
+    weights = (0.5 * np.outer(b.length, w)).ravel()
+    if segments is None:
+        rows = evaluate(rk, pts, gradients=True)
+    else:
+        keep = np.zeros(len(b.length), bool)
+        keep[segments] = True
+        keep = np.repeat(keep, k)
+        weights = np.where(keep, weights, 0.0)
+        mine = evaluate(rk, pts[keep], gradients=True)
+        indptr = np.zeros(len(pts) + 1, np.int64)
+        indptr[1:][keep] = np.diff(mine.indptr)
+        rows = SparseRows(np.cumsum(indptr), mine.indices, mine.data, mine.num_cols)
     return BoundaryQuadrature(
-        points=pts, normals=np.repeat(b.normal, k, axis=0), weights=(0.5 * np.outer(b.length, w)).ravel(),
-        tag=np.repeat(b.tag, k), spacing=np.repeat(p.spacing[b.node], k),
-        rows=evaluate(rk, pts, gradients=True))
+        points=pts, normals=np.repeat(b.normal, k, axis=0), weights=weights,
+        tag=np.repeat(b.tag, k), spacing=np.repeat(p.spacing[b.node], k), rows=rows)
 
 
 def _only(conditions: Sequence[Condition], kinds: tuple[type, ...], where: str) -> Sequence[Condition]:
@@ -178,7 +195,7 @@ class Collocation:
 
 
 def collocation(p: Particles, rk: RKApproximation, fields: Sequence[tuple[Sequence, int, int]],
-                num_unknowns: int) -> Collocation:
+                num_unknowns: int, nodes: np.ndarray | None = None) -> Collocation:
     """Collocation rows for the conditions of several fields of one problem.
 
     Args:
@@ -188,15 +205,17 @@ def collocation(p: Particles, rk: RKApproximation, fields: Sequence[tuple[Sequen
             are interleaved per node. A (node, component) pair already prescribed by an earlier
             condition is not prescribed again.
         num_unknowns: Columns of G.
+        nodes: Collocate only at these nodes (indices, e.g. a rank's owned nodes); the rows of
+            a partition's parts together are the rows of the whole.
     """
-    blocks, parts, seen = [], [], set()
+    blocks, parts, seen, only = [], [], set(), nodes
     for conditions, offset, ncomp in fields:
         for bc in _only(conditions, ESSENTIAL, "collocation"):
             nodes = part_nodes(p, bc.boundary)
             for j, c in enumerate(bc.components):
                 fresh = np.array([(offset, c, i) not in seen for i in nodes], bool)
                 seen.update((offset, c, i) for i in nodes)
-                sel = nodes[fresh]
+                sel = nodes[fresh] if only is None else nodes[fresh & np.isin(nodes, only)]
                 if sel.size == 0:
                     continue
                 coo = evaluate(rk, p.x[sel]).matrix(0).tocoo()
@@ -208,11 +227,11 @@ def collocation(p: Particles, rk: RKApproximation, fields: Sequence[tuple[Sequen
 
 
 def transformation_constraints(p: Particles, rk: RKApproximation, conditions: Sequence[Condition],
-                               t: float = 0.0) -> tuple[sp.csr_matrix, np.ndarray]:
+                               t: float = 0.0, nodes: np.ndarray | None = None) -> tuple[sp.csr_matrix, np.ndarray]:
     """Rows G (k, 2n) and values g (k,) at time t of u^h_c(x_I) = u_bar_c(x_I, t) at the nodes
     of Gamma_u, for essential conditions of ``rkfx.conditions`` on the displacement field (or
-    its velocity, ``Velocity``)."""
-    col = collocation(p, rk, [(conditions, 0, 2)], 2 * p.num_nodes)
+    its velocity, ``Velocity``); with ``nodes``, only at those of them (see ``collocation``)."""
+    col = collocation(p, rk, [(conditions, 0, 2)], 2 * p.num_nodes, nodes)
     return col.G, col.values(p.x, t)
 
 

@@ -76,35 +76,65 @@ def dni(p: Particles, rk: RKApproximation, domains: NodalDomains) -> Quadrature:
 
 @dataclass(frozen=True)
 class SmoothedGradients:
-    """Smoothed gradients of all shape functions on the nodal cells (eq. 3.55).
+    """Smoothed gradients of all shape functions on (a selection of) the nodal cells (eq. 3.55).
 
     Attributes:
-        cell: Rows per node L: grad~N_I(x_L) [1/m].
-        node_values: Rows per node L: N_I(x_L).
-        cell_minus_subcell: Rows per subcell C of node L: grad~N_I(x_L) - grad~N_I(x_hat_C),
+        cell: Rows per node L of ``nodes``: grad~N_I(x_L) [1/m].
+        node_values: Rows per node L of ``nodes``: N_I(x_L).
+        cell_minus_subcell: Rows per subcell C of ``subcells``: grad~N_I(x_L) - grad~N_I(x_hat_C),
             the subcell gradient smoothed over C (the MSCNI terms of eq. 3.56), or ``None``.
+        nodes: The nodes L of the rows, shape ``(num_rows,)`` (all nodes unless selected).
+        subcells: The subcells C of the stabilization rows, shape ``(num_subcell_rows,)``.
     """
 
     cell: SparseRows
     node_values: SparseRows
     cell_minus_subcell: SparseRows | None
+    nodes: np.ndarray
+    subcells: np.ndarray
 
 
 def smoothed_gradients(p: Particles, rk: RKApproximation, domains: NodalDomains,
-                       subcells: bool = True) -> SmoothedGradients:
+                       subcells: bool = True, nodes: np.ndarray | None = None) -> SmoothedGradients:
     """N at the smoothing points, combined into cell smoothed gradients and, with ``subcells``,
-    the MSCNI differences (formed in one pass, without storing subcell gradients)."""
+    the MSCNI differences (formed in one pass, without storing subcell gradients).
+
+    ``nodes`` (indices) restricts the rows to the cells of those nodes and their subcells (a
+    rank's owned cells, ``rkfx.parallel.ownership``): N is then evaluated only at their
+    smoothing points; the columns stay all nodes.
+    """
     d = domains
-    at_points = evaluate(rk, d.smoothing_points)
-    cell = combine_rows(at_points, d.cell_ptr, d.cell_point,
-                        d.cell_normal_length / np.repeat(d.area, np.diff(d.cell_ptr))[:, None])
+    num_cells = len(d.area)
+    if nodes is None:
+        nodes, sub, used = np.arange(num_cells), np.arange(len(d.subcell_area)), None
+        ptr, terms = d.cell_ptr, np.arange(len(d.cell_point))
+    else:
+        nodes = np.asarray(nodes, dtype=np.int64)
+        mine = np.zeros(num_cells, bool)
+        mine[nodes] = True
+        sub = np.flatnonzero(mine[d.subcell_node])
+        lengths = np.diff(d.cell_ptr)[nodes]
+        ptr = np.zeros(len(nodes) + 1, np.int64)
+        np.cumsum(lengths, out=ptr[1:])
+        terms = np.repeat(d.cell_ptr[nodes] - ptr[:-1], lengths) + np.arange(ptr[-1])
+        used = np.unique(np.concatenate([d.cell_point[terms], d.subcell_point[sub].ravel() if subcells else []])
+                         .astype(np.int64))
+
+    def local(point):  # index among the evaluated smoothing points
+        return point if used is None else np.searchsorted(used, point)
+
+    at_points = evaluate(rk, d.smoothing_points if used is None else d.smoothing_points[used])
+    cell = combine_rows(at_points, ptr, local(d.cell_point[terms]),
+                        d.cell_normal_length[terms] / np.repeat(d.area[nodes], np.diff(ptr))[:, None])
     diff = None
     if subcells:
-        ns = len(d.subcell_area)
-        diff = combine_rows(at_points, np.arange(0, 4 * ns + 1, 4), d.subcell_point.ravel(),
-                            (-d.subcell_normal_length / d.subcell_area[:, None, None]).reshape(-1, 2),
-                            base=cell, base_row=d.subcell_node)
-    return SmoothedGradients(cell, evaluate(rk, p.x), diff)
+        row_of = np.full(num_cells, -1, np.int64)
+        row_of[nodes] = np.arange(len(nodes))
+        ns = len(sub)
+        diff = combine_rows(at_points, np.arange(0, 4 * ns + 1, 4), local(d.subcell_point[sub].ravel()),
+                            (-d.subcell_normal_length[sub] / d.subcell_area[sub, None, None]).reshape(-1, 2),
+                            base=cell, base_row=row_of[d.subcell_node[sub]])
+    return SmoothedGradients(cell, evaluate(rk, p.x[nodes]), diff, nodes, sub)
 
 
 def subcell_gradients(rk: RKApproximation, domains: NodalDomains
@@ -129,44 +159,60 @@ def subcell_gradients(rk: RKApproximation, domains: NodalDomains
 
 
 def scni(p: Particles, rk: RKApproximation, domains: NodalDomains,
-         smoothed: SmoothedGradients | None = None) -> Quadrature:
-    """SCNI: smoothed gradients at the nodes, weights A_L (eq. 3.55)."""
-    s = smoothed or smoothed_gradients(p, rk, domains, subcells=False)
-    return Quadrature(p.x, domains.area, s.node_values, s.cell, "scni")
+         smoothed: SmoothedGradients | None = None, nodes: np.ndarray | None = None) -> Quadrature:
+    """SCNI: smoothed gradients at the nodes, weights A_L (eq. 3.55); with ``nodes``, only the
+    points of those nodes (ignored when ``smoothed`` is given: its nodes are used)."""
+    s = smoothed or smoothed_gradients(p, rk, domains, subcells=False, nodes=nodes)
+    return Quadrature(p.x[s.nodes], domains.area[s.nodes], s.node_values, s.cell, "scni")
 
 
 def mscni_stabilization(p: Particles, rk: RKApproximation, domains: NodalDomains,
                         smoothed: SmoothedGradients | None = None, eps_p: float = 1.0,
-                        with_values: bool = False) -> Quadrature:
+                        with_values: bool = False, nodes: np.ndarray | None = None) -> Quadrature:
     """The subcell terms of eq. (3.56): rows grad~N(x_L) - grad~N(x_hat_C), weights eps_p A_C.
 
     With ``with_values`` the value rows N(x_L) - N(x_hat_C) of eq. (3.58) are formed too.
+    With ``nodes``, only the subcells of those nodes (``smoothed``, when given, decides).
     """
     if not eps_p >= 0:
         raise InputError(f"eps_p = {eps_p!r} must be >= 0 (1 is the usual MSCNI choice)")
     d = domains
     s = smoothed if smoothed is not None and smoothed.cell_minus_subcell is not None else \
-        smoothed_gradients(p, rk, d, subcells=True)
+        smoothed_gradients(p, rk, d, subcells=True, nodes=nodes)
     diff = s.cell_minus_subcell
     values = None
     if with_values:
-        values = difference_rows(s.node_values, d.subcell_node, evaluate(rk, d.subcell_centroid))
-    return Quadrature(d.subcell_centroid, eps_p * d.subcell_area, values, diff, "mscni-stabilization")
+        row_of = np.full(len(d.area), -1, np.int64)
+        row_of[s.nodes] = np.arange(len(s.nodes))
+        values = difference_rows(s.node_values, row_of[d.subcell_node[s.subcells]],
+                                 evaluate(rk, d.subcell_centroid[s.subcells]))
+    return Quadrature(d.subcell_centroid[s.subcells], eps_p * d.subcell_area[s.subcells], values, diff,
+                      "mscni-stabilization")
 
 
 RULES = ("gauss1", "gauss2", "gauss4", "dni", "scni", "mscni")
 
 
+NODAL_RULES = ("scni", "mscni")  # the rules whose points are the nodes' cells (selectable by ``nodes``)
+
+
 def integration_rules(name: str, p: Particles, rk: RKApproximation, domains: NodalDomains,
-                      eps_p: float = 1.0) -> list[Quadrature]:
-    """The quadratures of a named rule (``mscni`` gives two: SCNI and its stabilization)."""
+                      eps_p: float = 1.0, nodes: np.ndarray | None = None) -> list[Quadrature]:
+    """The quadratures of a named rule (``mscni`` gives two: SCNI and its stabilization).
+
+    ``nodes`` (indices) keeps only the integration points of those nodes' cells (a rank's
+    owned cells); only the nodal rules ``scni`` and ``mscni`` have such a selection.
+    """
+    if nodes is not None and name not in NODAL_RULES:
+        raise InputError(f"rule {name!r} has no selection of points by node; use one of {', '.join(NODAL_RULES)} "
+                         "(or assemble on every rank whole)")
     if name.startswith("gauss") and name in RULES:
         return [gauss(p, rk, int(name[5:]))]
     if name == "dni":
         return [dni(p, rk, domains)]
     if name == "scni":
-        return [scni(p, rk, domains)]
+        return [scni(p, rk, domains, nodes=nodes)]
     if name == "mscni":
-        s = smoothed_gradients(p, rk, domains, subcells=True)
+        s = smoothed_gradients(p, rk, domains, subcells=True, nodes=nodes)
         return [scni(p, rk, domains, s), mscni_stabilization(p, rk, domains, s, eps_p)]
     raise InputError(f"unknown integration rule {name!r}; choose one of {', '.join(RULES)}")

@@ -39,19 +39,23 @@ class _ScipyLU:
         pass
 
 
-def linear_solver(a: sp.spmatrix, comm=None, solver: str = "mumps", mumps_icntl: Mapping[int, int] | None = None):
+def linear_solver(a: sp.spmatrix, comm=None, solver: str = "mumps", mumps_icntl: Mapping[int, int] | None = None,
+                  owned_rows: bool = False):
     """An object with ``.solve(b)`` and ``.destroy()`` for the matrix ``a`` (``mumps_icntl``:
     further MUMPS controls, see ``rkfx.linalg.petsc.make_ksp``; ignored without PETSc).
-    ``solver="serial"``: SuperLU on each rank, for a small system every rank holds whole."""
+    ``solver="serial"``: SuperLU on each rank, for a small system every rank holds whole.
+    ``owned_rows``: ``a`` and every ``b`` are this rank's block of rows of a distributed system
+    (``rkfx.parallel.rows.owned_block``); ``solve`` still returns the whole solution."""
     if solver == "serial":
         return _ScipyLU(a)
     try:
         from rkfx.linalg import petsc  # noqa: PLC0415
     except ImportError:
-        if solver != "mumps":
-            raise InputError(f"solver {solver!r} needs PETSc: pip install 'rkfx[fem]'") from None
+        if solver != "mumps" or (owned_rows and comm is not None and comm.size > 1):
+            raise InputError(f"solver {solver!r}{' on distributed rows' * owned_rows} needs PETSc: pip install 'rkfx[fem]'") from None
         return _ScipyLU(a)
-    return petsc.LinearSolver(a, comm if comm is not None else petsc.MPI.COMM_WORLD, solver, mumps_icntl)
+    return petsc.LinearSolver(a, comm if comm is not None else petsc.MPI.COMM_WORLD, solver, mumps_icntl, owned_rows)
+
 
 
 class Factorizations:

@@ -3,7 +3,9 @@
 Import on purpose (``import rkfx.linalg.petsc``); the numerical core never imports PETSc. Every
 function takes an MPI communicator. Matrices are distributed by contiguous row blocks
 (PETSc's default ownership); each rank inserts only the rows it owns from the CSR data it
-holds, so the same code runs serially and under ``mpiexec -n P``.
+holds, so the same code runs serially and under ``mpiexec -n P``. A rank that holds only its
+own block of rows (``rkfx.parallel.rows.owned_block``) builds the matrix with ``owned_rows_mat``,
+preallocated from the block's diagonal and off-diagonal counts.
 """
 import warnings
 from collections.abc import Mapping
@@ -32,6 +34,28 @@ def to_petsc_mat(a: sp.spmatrix, comm=MPI.COMM_WORLD) -> PETSc.Mat:
     mat.setType(PETSc.Mat.Type.AIJ)
     mat.setUp()
     mat.setPreallocationCSR(_owned_rows(a, mat))
+    mat.assemble()
+    return mat
+
+
+def owned_rows_mat(block: sp.spmatrix, comm=MPI.COMM_WORLD) -> PETSc.Mat:
+    """Distributed square AIJ matrix from this rank's block of rows, shape ``(local_rows, n)``
+    in a global numbering where the ranks' blocks follow each other in rank order; preallocated
+    exactly (d_nnz: columns inside the block's own range, o_nnz: the others)."""
+    block = _sorted_csr(block)
+    m, n = block.shape
+    mat = PETSc.Mat().create(comm=comm)
+    mat.setSizes(((m, n), (m, n)))
+    mat.setType(PETSc.Mat.Type.AIJ)
+    lo = (comm.exscan(m) or 0) if comm.size > 1 else 0  # the block's first global row
+    inside = (block.indices >= lo) & (block.indices < lo + m)
+    row = np.repeat(np.arange(m), np.diff(block.indptr))
+    d_nnz = np.bincount(row[inside], minlength=m).astype(PETSc.IntType)
+    o_nnz = (np.diff(block.indptr) - d_nnz).astype(PETSc.IntType)
+    mat.setPreallocationNNZ((d_nnz, o_nnz))
+    mat.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
+    mat.setValuesCSR(block.indptr.astype(PETSc.IntType), block.indices.astype(PETSc.IntType),
+                     block.data.astype(PETSc.ScalarType))
     mat.assemble()
     return mat
 
@@ -113,11 +137,15 @@ class LinearSolver:
     """
 
     def __init__(self, a: sp.spmatrix, comm=MPI.COMM_WORLD, solver: str = "mumps",
-                 mumps_icntl: Mapping[int, int] | None = None):
-        self.solver = solver
+                 mumps_icntl: Mapping[int, int] | None = None, owned_rows: bool = False):
+        self.solver, self.owned_rows = solver, owned_rows
         a = _sorted_csr(a)
-        self.pattern = (a.shape, a.indptr.copy(), a.indices.copy())
-        self.mat = to_petsc_mat(a, comm)
+        if owned_rows:  # a is this rank's block of rows (owned_rows_mat); b is too
+            self.pattern = None
+            self.mat = owned_rows_mat(a, comm)
+        else:
+            self.pattern = (a.shape, a.indptr.copy(), a.indices.copy())
+            self.mat = to_petsc_mat(a, comm)
         self.ksp = make_ksp(self.mat, solver, mumps_icntl=mumps_icntl)
         self.rhs = self.mat.createVecLeft()
         self.x = self.mat.createVecRight()
@@ -126,9 +154,11 @@ class LinearSolver:
         self._warned = False
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        """The whole solution on every rank."""
+        """The whole solution on every rank (``b``: the whole right-hand side, or this rank's
+        entries of it when the solver was built from owned rows)."""
         lo, hi = self.rhs.getOwnershipRange()
-        self.rhs.array[:] = np.asarray(b, dtype=PETSc.ScalarType)[lo:hi]
+        b = np.asarray(b, dtype=PETSc.ScalarType)
+        self.rhs.array[:] = b if self.owned_rows else b[lo:hi]
         try:
             self.ksp.solve(self.rhs, self.x)
         except PETSc.Error as err:
@@ -161,6 +191,8 @@ class LinearSolver:
 
     def matches(self, a: sp.spmatrix) -> bool:
         """Whether ``a`` has this system's sparsity pattern (so ``refactor`` may take it)."""
+        if self.pattern is None:
+            return False
         a = _sorted_csr(a)
         shape, indptr, indices = self.pattern
         return a.shape == shape and np.array_equal(a.indptr, indptr) and np.array_equal(a.indices, indices)

@@ -16,10 +16,13 @@ from rkfx.conditions import Condition, Displacement, Traction, split
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.linalg.linear_solver import linear_solver
 from rkfx.errors import InputError
-from rkfx.geometry.nodal_domains import nodal_domains
+from rkfx.geometry.nodal_domains import NodalDomains, nodal_domains
 from rkfx.assembly.operators import load_vector, stiffness
 from rkfx.geometry.particles import Particles
-from rkfx.integration.quadrature import integration_rules
+from rkfx.integration.quadrature import NODAL_RULES, integration_rules
+from rkfx.parallel.ownership import numbering
+from rkfx.parallel.partition import rcb
+from rkfx.parallel.rows import owned_block, owned_entries
 from rkfx.approximation.shape_functions import RKApproximation, evaluate, rk_approximation
 
 
@@ -53,7 +56,7 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, conditions: Sequ
                        *, body_force: Callable[[np.ndarray], np.ndarray] | None = None,
                        rule: str = "mscni", bc_method: str = "nitsche", support_factor: float = 1.5,
                        order: int = 1, nitsche_penalty: float = 100.0, comm=None,
-                       solver: str = "mumps") -> ElasticSolution:
+                       solver: str = "mumps", distributed: bool | None = None) -> ElasticSolution:
     """Solve plane-strain elasticity on ``p``.
 
     Args:
@@ -70,37 +73,114 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, conditions: Sequ
         nitsche_penalty: Dimensionless Nitsche parameter.
         comm: MPI communicator for the PETSc solve (default COMM_WORLD).
         solver: ``mumps`` | ``gmres-ilu`` | ``cg-gamg``.
+        distributed: Assemble by owned rows (``_solve_by_owned_rows``): each rank integrates
+            over the cells of its part of an RCB partition only. ``None`` (default): when
+            ``comm`` has more than one rank and the rule is nodal (``scni``, ``mscni``); the
+            other rules are assembled whole on every rank, as with ``False``.
     """
     displacements, tractions = _displacements_and_tractions(conditions)
     if bc_method not in BC_METHODS:
         raise InputError(f"unknown bc_method {bc_method!r}; choose one of {', '.join(BC_METHODS)}")
+    if distributed is None:
+        distributed = comm is not None and comm.size > 1 and rule in NODAL_RULES
+    elif distributed and rule not in NODAL_RULES:
+        raise InputError(f"distributed=True needs a nodal rule ({', '.join(NODAL_RULES)}), not {rule!r}; "
+                         "choose one, or distributed=False")
     times = {}
     t0 = time.perf_counter()
     rk = rk_approximation(p.x, p.spacing, support_factor, order)
     domains = nodal_domains(p)
-    quads = integration_rules(rule, p, rk, domains)
-    d = material.D()
-    k = stiffness(quads, d)
-    bq = boundary_quadrature(p, domains, rk)
-    f = traction_load(p, bq, tractions)
-    if body_force is not None:
-        q = quads[0]
-        f += load_vector(q.values, q.weights, body_force(q.points))
-    times["assemble"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    g, gv = transformation_constraints(p, rk, displacements)
+    terms = dict(material=material, displacements=displacements, tractions=tractions, body_force=body_force,
+                 rule=rule, bc_method=bc_method, nitsche_penalty=nitsche_penalty)
+    if distributed:
+        coefficients = _solve_by_owned_rows(p, rk, domains, terms, comm, solver, times, t0)
+        return ElasticSolution(rk, coefficients, 2 * p.num_nodes, times)
+    k, f, g, gv = elastic_terms(p, rk, domains, **terms)
     _check_rigid_modes(p, g)
     if bc_method == "nitsche":
-        kn, fn = nitsche_terms(p, bq, d, displacements, nitsche_penalty)
-        system, rhs = k + kn, f + fn
+        system, rhs = k, f
     else:
         system = sp.bmat([[k, g.T], [g, None]], format="csr")
         rhs = np.concatenate([f, gv])
+    times["assemble"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
     ls = linear_solver(system, comm, solver)
     x = ls.solve(rhs)
     ls.destroy()
     times["solve"] = time.perf_counter() - t0
     return ElasticSolution(rk, x[:2 * p.num_nodes].reshape(-1, 2), 2 * p.num_nodes, times)
+
+
+def elastic_terms(p: Particles, rk: RKApproximation, domains: NodalDomains, material: ElasticMaterial,
+                  displacements: Sequence[Displacement], tractions: Sequence[Traction],
+                  body_force: Callable[[np.ndarray], np.ndarray] | None, rule: str, bc_method: str,
+                  nitsche_penalty: float, nodes: np.ndarray | None = None
+                  ) -> tuple[sp.csr_matrix, np.ndarray, sp.csr_matrix, np.ndarray]:
+    """The stiffness K (2n, 2n) and load f (2n,), with the Nitsche terms for ``nitsche``, and
+    the collocation rows G (k, 2n) and values g (k,) of the displacement conditions.
+
+    ``nodes`` (indices, a nodal rule only) integrates over those nodes' cells and boundary
+    half-segments and collocates at those of them on Gamma_u: a rank's share, whose K and f
+    summed over a partition's parts (and G stacked) are the whole ones.
+    """
+    d = material.D()
+    quads = integration_rules(rule, p, rk, domains, nodes=nodes)
+    k = stiffness(quads, d)
+    segments = None if nodes is None else np.flatnonzero(np.isin(domains.boundary.node, nodes))
+    bq = boundary_quadrature(p, domains, rk, segments=segments)
+    f = traction_load(p, bq, tractions)
+    if body_force is not None:
+        q = quads[0]
+        f += load_vector(q.values, q.weights, body_force(q.points))
+    g, gv = transformation_constraints(p, rk, displacements, nodes=nodes)
+    if bc_method == "nitsche":
+        kn, fn = nitsche_terms(p, bq, d, displacements, nitsche_penalty)
+        k, f = k + kn, f + fn
+    return k, f, g, gv
+
+
+def _solve_by_owned_rows(p: Particles, rk: RKApproximation, domains: NodalDomains, terms: dict, comm,
+                         solver: str, times: dict, t0: float) -> np.ndarray:
+    """The coefficients, shape ``(n, 2)``, on every rank, from a system assembled by owned rows.
+
+    The nodes are split by RCB (``rkfx.parallel.partition``); each rank integrates over its
+    nodes' cells only (``elastic_terms`` with ``nodes``), renumbers its contributions so that
+    each rank's unknowns are contiguous (its nodes' displacements, then the multipliers of the
+    collocation rows at its nodes), sends the rows owned elsewhere to their owners
+    (``rkfx.parallel.rows``) and hands its block of rows to a preallocated PETSc matrix.
+    ``times`` gets the stages' wall times, assembly counted from ``t0``.
+    """
+    rank, size = (0, 1) if comm is None else (comm.rank, comm.size)
+    part = rcb(p.x, size)
+    num = numbering(part, size)
+    owned = num.old_of_new[num.ranges[rank]:num.ranges[rank + 1]]
+    k, f, g, gv = elastic_terms(p, rk, domains, nodes=owned, **terms)
+    _check_rigid_modes(p, g, comm)
+    mine = g.shape[0] if terms["bc_method"] == "transformation" else 0
+    multipliers = np.array(comm.allgather(mine) if size > 1 else [mine])
+    starts = np.zeros(size + 1, np.int64)
+    np.cumsum(2 * np.diff(num.ranges) + multipliers, out=starts[1:])
+    # Global unknown of every (node, component) and of this rank's multipliers.
+    first = starts[part] + 2 * (num.new_of_old - num.ranges[part])
+    unknown = np.concatenate([(first[:, None] + np.arange(2)).ravel(),
+                              starts[rank] + 2 * len(owned) + np.arange(mine)])
+    if mine:
+        k = sp.bmat([[k, g.T], [g, None]], format="coo")
+        f = np.concatenate([f, gv])
+    k = sp.coo_matrix(k)
+    total = int(starts[-1])
+    contribution = sp.csr_matrix((k.data, (unknown[k.row], unknown[k.col])), shape=(total, total))
+    rhs = np.zeros(total)
+    rhs[unknown] = f
+    block = owned_block(contribution, starts, comm)
+    b = owned_entries(rhs, starts, comm)
+    times["assemble"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    ls = linear_solver(block, comm, solver, owned_rows=True)
+    x = ls.solve(b)
+    ls.destroy()
+    times["solve"] = time.perf_counter() - t0
+    return x[unknown[:2 * p.num_nodes]].reshape(-1, 2)
 
 
 def _displacements_and_tractions(conditions: Sequence[Condition]) -> tuple[list, list]:
@@ -115,8 +195,9 @@ def _displacements_and_tractions(conditions: Sequence[Condition]) -> tuple[list,
     return by_kind[Displacement], by_kind[Traction]
 
 
-def _check_rigid_modes(p: Particles, g: sp.csr_matrix) -> None:
+def _check_rigid_modes(p: Particles, g: sp.csr_matrix, comm=None) -> None:
     """Raise if the prescribed displacements leave a rigid-body mode free (K would be singular).
+    With ``comm``, ``g`` is this rank's share of the rows (all ranks' rows are checked).
 
     RK shape functions reproduce linear fields, so coefficients equal to the rigid motions'
     nodal values are exactly the rigid modes; each must violate some constraint row.
@@ -127,6 +208,8 @@ def _check_rigid_modes(p: Particles, g: sp.csr_matrix) -> None:
     modes[1::2, 1] = 1.0
     modes[0::2, 2], modes[1::2, 2] = -x[:, 1], x[:, 0]
     seen = g @ modes if g.shape[0] else np.zeros((0, 3))
+    if comm is not None and comm.size > 1:
+        seen = np.vstack(comm.allgather(seen))
     sv = np.linalg.svd(seen, compute_uv=False) if len(seen) else np.zeros(0)
     scale = np.abs(modes).max()
     if len(sv) < 3 or sv[-1] <= 1e-10 * scale * max(sv[0], 1.0):

@@ -1,0 +1,52 @@
+"""Rows of a distributed sparse system: each rank's contributions sent to the rows' owners.
+
+A rank integrates over its owned points only, so its contribution to a matrix (or vector)
+touches the rows of its owned and ghost unknowns. ``owned_block`` sends the rows owned
+elsewhere to their owners and sums what each rank receives into the block of rows it owns,
+which is what a row-distributed PETSc matrix needs (``rkfx.linalg.petsc.LinearSolver`` with
+``owned_rows=True``). ``comm`` is any mpi4py-style communicator (``rank``, ``size``,
+``alltoall``) or ``None``; this module does not import MPI.
+"""
+import numpy as np
+import scipy.sparse as sp
+
+
+def owned_block(a: sp.spmatrix, ranges: np.ndarray, comm=None) -> sp.csr_matrix:
+    """The rows ``ranges[rank]:ranges[rank + 1]`` of the sum over ranks of ``a``.
+
+    Args:
+        a: This rank's contribution in the global numbering, shape ``(num_rows, num_cols)``.
+        ranges: Rank r owns rows ``ranges[r]:ranges[r + 1]``, shape ``(comm.size + 1,)``.
+        comm: Communicator, or ``None`` for one rank.
+
+    Returns:
+        Shape ``(ranges[rank + 1] - ranges[rank], num_cols)``, sorted indices, duplicates summed.
+    """
+    a = sp.csr_matrix(a)
+    rank, size = (0, 1) if comm is None else (comm.rank, comm.size)
+    lo, hi = int(ranges[rank]), int(ranges[rank + 1])
+    mine = a[lo:hi]
+    if size > 1:
+        filled = np.flatnonzero(np.diff(a.indptr))
+        owner = np.searchsorted(ranges, filled, side="right") - 1
+        sends = []
+        for r in range(size):
+            rows = filled[owner == r] if r != rank else filled[:0]
+            sub = a[rows]
+            sends.append((rows - ranges[r], sub.indptr, sub.indices, sub.data))
+        for rows, indptr, indices, data in comm.alltoall(sends):
+            if len(rows):
+                got = sp.csr_matrix((data, indices, indptr), shape=(len(rows), a.shape[1])).tocoo()
+                mine = mine + sp.csr_matrix((got.data, (rows[got.row], got.col)), shape=mine.shape)
+    mine = sp.csr_matrix(mine)
+    mine.sum_duplicates()
+    mine.sort_indices()
+    return mine
+
+
+def owned_entries(v: np.ndarray, ranges: np.ndarray, comm=None) -> np.ndarray:
+    """The entries ``ranges[rank]:ranges[rank + 1]`` of the sum over ranks of the vector ``v``
+    (this rank's contribution, nonzero on its owned and ghost unknowns only)."""
+    v = np.asarray(v, dtype=np.float64)
+    column = sp.csr_matrix(v.reshape(-1, 1))
+    return owned_block(column, ranges, comm).toarray().ravel()
