@@ -38,7 +38,8 @@ data path (see docs/core.md):
         partition        recursive coordinate bisection of the nodes into parts
         ownership        a rank's owned nodes and ghosts, the numbering with contiguous parts
         rows             a rank's contributions sent to the owners of their rows
-        ranks            serial work under MPI: rank 0 runs it, every rank gets the result
+        ranks            serial work under MPI: rank 0 runs it, the others sleep until they get the result
+        threads          numba threads per rank: each rank its share of its node's cores
     conditions      boundary conditions: one vocabulary, values of x and t
     errors          errors naming the culprit and the fix
     warmup          compile the kernels before timing

@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from rkfx.errors import InputError, SolverError
+from rkfx.parallel.threads import share_cores
 from rkfx.warmup import warm_up
 
 METHODS = {"rkpm": ("rkpm",), "fem": ("fem",), "both": ("rkpm", "fem")}
@@ -239,6 +240,9 @@ def main(name: str, doc: str | None, specs: Mapping[str, Param], run: Callable[.
                                      "directory of the interrupted run")
             extra = {"checkpoint_every": args.checkpoint_every, "work_dir": Path(args.out) / "checkpoints",
                      "resume": None if args.resume is None else args.resume / "checkpoints"}
+        world = comm()
+        if world is not None and world.size > 1:
+            share_cores(world)  # ranks x threads <= cores
         warm_up()  # wall times below measure the methods, not the JIT compiler
         results = run(methods=METHODS[args.method], **params, **extra)
     except (InputError, SolverError) as err:
