@@ -1,0 +1,62 @@
+"""Benchmark: the RK elastic solve (MSCNI, Nitsche, MUMPS) serially and over MPI ranks.
+
+The manufactured sine field on an n x n grid of nodes; on more than one rank the system is
+assembled by owned rows (``rkfx.parallel``). Prints the assembly and solve times (max over
+ranks), the peak RSS of every rank, and the relative difference of the gathered coefficients
+to a serial run's saved with ``--save``.
+
+Usage:
+    python bench/parallel_elastic.py [--nodes 300] [--save serial.npy]
+    mpiexec -n 2 env NUMBA_NUM_THREADS=1 python bench/parallel_elastic.py --compare serial.npy
+The last line printed reads ``<ranks> ranks x <threads> threads, <N> nodes: <seconds> s``.
+"""
+import argparse
+import resource
+import time
+
+import dolfinx_solver  # noqa: F401  (before mpi4py)
+import numba
+import numpy as np
+from mpi4py import MPI
+
+from rkfx.conditions import Displacement
+from rkfx.geometry.particles import structured
+from rkfx.materials.elasticity import ElasticMaterial
+from rkfx.models.elastostatics import solve_plane_strain
+from rkfx.warmup import warm_up
+from verification.manufactured import SineField
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--nodes", type=int, default=300, help="nodes per side")
+    ap.add_argument("--save", help="write the coefficients (rank 0) to this .npy file")
+    ap.add_argument("--compare", help="report the relative difference to these saved coefficients")
+    args = ap.parse_args()
+    comm = MPI.COMM_WORLD
+    warm_up()
+    p = structured(1.0, 1.0, args.nodes, args.nodes)
+    material = ElasticMaterial(1.0, 0.3)
+    field = SineField(material.lame_lambda, material.shear_modulus)
+    bcs = [Displacement(side, lambda x, t: field.displacement(x)) for side in p.boundary_names]
+    comm.Barrier()
+    t0 = time.perf_counter()
+    sol = solve_plane_strain(p, material, bcs, body_force=field.body_force, rule="mscni", comm=comm)
+    wall = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
+    stages = {k: comm.allreduce(v, op=MPI.MAX) for k, v in sol.timings.items()}
+    rss = comm.gather(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, root=0)
+    if comm.rank != 0:
+        return
+    print("stages [s, max over ranks]: " + ", ".join(f"{k} {v:.2f}" for k, v in stages.items()))
+    print("peak RSS per rank [MB]: " + ", ".join(f"{r:.0f}" for r in rss))
+    if args.save:
+        np.save(args.save, sol.coefficients)
+    if args.compare:
+        ref = np.load(args.compare)
+        print(f"max relative difference to {args.compare}: "
+              f"{np.abs(sol.coefficients - ref).max() / np.abs(ref).max():.2e}")
+    print(f"{comm.size} ranks x {numba.get_num_threads()} threads, {p.num_nodes} nodes: {wall:.2f} s")
+
+
+if __name__ == "__main__":
+    main()
