@@ -115,3 +115,39 @@ def test_cli_writes_metrics_and_rejects_bad_input(tmp_path, capsys):
             kalthoff.main(["--method", "rkpm", "--out", str(tmp_path / "x"), *bad])
         assert err.value.code == 2
         assert len(capsys.readouterr().err.strip().splitlines()) == 1
+
+
+def test_outputs_and_ranges_are_checked_before_the_run(tmp_path, capsys, monkeypatch):
+    """A bad --out or an out-of-range parameter stops the case in one line, before any model runs."""
+    ran = []
+    monkeypatch.setattr(kalthoff, "run", lambda **kw: ran.append(kw))
+    a_file = tmp_path / "results.txt"
+    a_file.write_text("not a folder")
+    for bad in (["--out", str(a_file)], ["--out", str(a_file / "sub")], ["--out", ""]):
+        with pytest.raises(SystemExit) as err:
+            kalthoff.main(["--method", "rkpm", *bad])
+        assert err.value.code == 2
+        message = capsys.readouterr().err.strip().splitlines()
+        assert len(message) == 1 and "--out" in message[0], message
+    assert ran == []
+    monkeypatch.undo()
+    for bad in ("support_factor=1.5", "courant=2", "radius=0"):
+        with pytest.raises(SystemExit) as err:
+            kalthoff.main(["--method", "rkpm", "--out", str(tmp_path / "y"), "--set", bad])
+        assert err.value.code == 2
+        message = capsys.readouterr().err.strip().splitlines()
+        assert len(message) == 1 and bad.split("=")[0] in message[0], message
+
+
+def test_resume_without_out_completes_the_resumed_folder(tmp_path, monkeypatch):
+    seen = {}
+
+    def fake_run(**kw):
+        seen.update(kw)
+        return kalthoff.Results(kalthoff.NAME, {}, [])
+
+    monkeypatch.setattr(kalthoff, "run", fake_run)
+    (tmp_path / "checkpoints").mkdir()
+    kalthoff.main(["--method", "rkpm", "--resume", str(tmp_path)])
+    assert seen["work_dir"] == tmp_path / "checkpoints" and seen["resume"] == tmp_path / "checkpoints"
+    assert (tmp_path / "results.json").is_file()

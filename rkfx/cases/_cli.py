@@ -176,8 +176,8 @@ def build_parser(name: str, doc: str | None, specs: Mapping[str, Param],
     parser.add_argument("--method", choices=list(METHODS), default="both", help="methods to run (default both)")
     parser.add_argument("--set", dest="overrides", action="extend", nargs="+", default=[], metavar="NAME=VALUE",
                         help="override parameters (--set a=1 b=2 or --set a=1 --set b=2)")
-    parser.add_argument("--out", type=Path, default=Path("results") / name,
-                        help=f"output directory (default results/{name}/)")
+    parser.add_argument("--out", type=Path, default=None,
+                        help=f"output directory (default results/{name}/, or DIR with --resume DIR)")
     if checkpoints:
         parser.add_argument("--checkpoint-every", type=int, default=0, metavar="N",
                             help="write a checkpoint every N time steps (into OUT/checkpoints/)")
@@ -229,6 +229,8 @@ def main(name: str, doc: str | None, specs: Mapping[str, Param], run: Callable[.
     """
     parser = build_parser(name, doc, specs, quick, checkpoints)
     args = parser.parse_args(argv)
+    if args.out is None:  # a resumed run completes the folder it resumes
+        args.out = getattr(args, "resume", None) or Path("results") / name
     try:
         params = parse_params(specs, args.overrides, quick if args.quick else None)
         extra = {}
@@ -240,6 +242,7 @@ def main(name: str, doc: str | None, specs: Mapping[str, Param], run: Callable[.
                                      "directory of the interrupted run")
             extra = {"checkpoint_every": args.checkpoint_every, "work_dir": Path(args.out) / "checkpoints",
                      "resume": None if args.resume is None else args.resume / "checkpoints"}
+        check_out(args.out, raw=argv if argv is not None else sys.argv[1:])
         world = comm()
         if world is not None and world.size > 1:
             share_cores(world)  # ranks x threads <= cores
@@ -275,6 +278,29 @@ def jsonable(obj: Any) -> Any:
     if isinstance(obj, Path):
         return str(obj)
     return obj
+
+
+def check_out(out: Path, raw: Sequence[str] = ()) -> None:
+    """Refuse an output folder that cannot take the results, before anything runs.
+
+    ``raw``: the command line, to tell an empty ``--out ""`` (which Path reads as ".") apart.
+    """
+    raw = list(raw)
+    given = [raw[i + 1] for i, a in enumerate(raw[:-1]) if a == "--out"] + \
+        [a.split("=", 1)[1] for a in raw if a.startswith("--out=")]
+    if any(not g.strip() for g in given):
+        raise ParameterError('--out "": give an output folder (default results/<case>/)')
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise ParameterError(f"--out {out}: is a file, not a folder; choose another output folder")
+    # The nearest existing folder must take new entries; nothing is created before the run.
+    base = out.absolute()
+    while not base.exists():
+        base = base.parent
+    if not base.is_dir():
+        raise ParameterError(f"--out {out}: {base} is a file, not a folder; choose another output folder")
+    if not os.access(base, os.W_OK | os.X_OK):
+        raise ParameterError(f"--out {out}: {base} is not writable; choose a writable output folder")
 
 
 def write_results(results: Results, out: Path) -> Path:

@@ -108,6 +108,14 @@ def _check(E, nu, rho, ft, GF, v0, t_end, tol, nodes, support_factor, courant, r
     for name, v in (("rho", rho), ("v0", v0), ("t_end", t_end), ("angle_radius", angle_radius)):
         if not (np.isfinite(v) and v > 0):
             raise InputError(f"{name} = {v!r} must be positive")
+    if not support_factor >= 1.6:
+        raise InputError(f"support_factor = {support_factor!r}: use >= 1.6, the crack hides nodes from the points "
+                         "beside it and a smaller support leaves them too few (see the module docstring)")
+    if not 0.0 < courant <= 1.0:
+        raise InputError(f"courant = {courant!r}: use 0 < courant <= 1 (dt = courant h / c_d; stability)")
+    for name, v in (("radius", radius), ("tol", tol)):
+        if not (np.isfinite(v) and v > 0):
+            raise InputError(f"{name} = {v!r} must be positive")
     for n in nodes:
         if n < 20:
             raise InputError(f"nodes = {n}: use at least 20 particles per side (the crack needs cells around it)")
