@@ -182,3 +182,18 @@ def test_bad_input_names_the_culprit():
         integrate(nm.trapezoidal(), Oscillator(), [0.0, 0.0])
     with pytest.raises(InputError, match="output times"):
         time_grid([0.0], 0.1)
+
+
+def test_resume_is_reported_and_a_garbled_checkpoint_named(tmp_path, caplog):
+    import logging
+
+    from rkfx.solvers.checkpoint import load_arrays, save_arrays
+
+    save_arrays(tmp_path / "run", {"state__step": np.int64(24), "x": np.ones(3)})
+    with caplog.at_level(logging.INFO, logger="rkfx"):
+        assert load_arrays(tmp_path / "run")["x"].sum() == 3
+    assert "run continues from step 24" in caplog.text
+    path = tmp_path / "run" / "checkpoint.npz"
+    path.write_bytes(path.read_bytes()[:40])  # truncated, as by a full disk
+    with pytest.raises(InputError, match=r"checkpoint.npz is unreadable .*delete .*run"):
+        load_arrays(tmp_path / "run")

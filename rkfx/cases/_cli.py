@@ -18,6 +18,7 @@ Results go to ``DIR/results.json`` (default ``results/<name>/``) with the schema
 """
 import argparse
 import json
+import logging
 import math
 import os
 import sys
@@ -243,6 +244,7 @@ def main(name: str, doc: str | None, specs: Mapping[str, Param], run: Callable[.
             extra = {"checkpoint_every": args.checkpoint_every, "work_dir": Path(args.out) / "checkpoints",
                      "resume": None if args.resume is None else args.resume / "checkpoints"}
         check_out(args.out, raw=argv if argv is not None else sys.argv[1:])
+        _report_resumes(args.resume if checkpoints else None)
         world = comm()
         if world is not None and world.size > 1:
             share_cores(world)  # ranks x threads <= cores
@@ -278,6 +280,18 @@ def jsonable(obj: Any) -> Any:
     if isinstance(obj, Path):
         return str(obj)
     return obj
+
+
+def _report_resumes(resume: Path | None) -> None:
+    """With ``--resume``, say on stderr (rank 0) which runs are read back and where each continues."""
+    log = logging.getLogger("rkfx")
+    if resume is None or _rank() != 0 or any(getattr(h, "rkfx_resume", False) for h in log.handlers):
+        return
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("%(message)s"))
+    handler.rkfx_resume = True
+    log.addHandler(handler)
+    log.setLevel(logging.INFO)
 
 
 def check_out(out: Path, raw: Sequence[str] = ()) -> None:

@@ -60,7 +60,7 @@ from rkfx.materials.damage_law import damage_kernel, strain_kernel
 from rkfx.errors import InputError
 from rkfx.parallel.ranks import on_root
 from rkfx.solvers.central_difference import CentralDifference, Constraint, ExplicitDynamics, ExplicitState
-from rkfx.solvers.checkpoint import copy_into
+from rkfx.solvers.checkpoint import copy_into, log, read_arrays
 
 HISTORY = ("time", "dissipated", "damaged", "kinetic", "internal", "external")
 
@@ -314,12 +314,12 @@ class DamageRun:
 
     @classmethod
     def load(cls, path: Path) -> "DamageRun":
-        with np.load(path) as z:
-            if "dissipation" not in z:
-                raise InputError(f"{path} predates the per-particle crack outputs; run again without --resume")
-            return cls(str(z["label"]), z["history"], z["damage"], z["kappa"], z["normal"], z["initiation_time"],
-                       z["opening"], z["dissipation"], z["displacement"], z["velocity"], int(z["steps"]),
-                       float(z["dt"]), float(z["wall_time_s"]), float(z["energy_error"]))
+        z = read_arrays(path)
+        if "dissipation" not in z:
+            raise InputError(f"{path} predates the per-particle crack outputs; run again without --resume")
+        return cls(str(z["label"]), z["history"], z["damage"], z["kappa"], z["normal"], z["initiation_time"],
+                   z["opening"], z["dissipation"], z["displacement"], z["velocity"], int(z["steps"]),
+                   float(z["dt"]), float(z["wall_time_s"]), float(z["energy_error"]))
 
 
 def run_key(label: str) -> str:
@@ -358,7 +358,9 @@ def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, mode
         raise InputError("checkpoint_every needs a work directory (the case's --out)")
     key = run_key(label)
     if resume is not None and (Path(resume) / key / "result.npz").is_file():
-        return DamageRun.load(Path(resume) / key / "result.npz")
+        done = DamageRun.load(Path(resume) / key / "result.npz")
+        log.info("resume: %s read back finished (%s)", label, Path(resume) / key / "result.npz")
+        return done
     steps = int(np.ceil(t_end / dt - 1e-9))
     every = max(1, steps // samples)
     start = None

@@ -1,7 +1,10 @@
 """Checkpoint files: named arrays written atomically, so an interrupted run never leaves a
 half-written checkpoint (temporary file, fsync, then ``os.replace``)."""
+import logging
 import os
 import sys
+import zipfile
+import zlib
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -10,6 +13,7 @@ import numpy as np
 from rkfx.errors import InputError
 
 CHECKPOINT = "checkpoint.npz"
+log = logging.getLogger("rkfx")
 
 
 def writes(comm) -> bool:
@@ -38,13 +42,27 @@ def save_arrays(directory: str | Path, arrays: Mapping[str, np.ndarray], name: s
     return target
 
 
+def read_arrays(path: str | Path) -> dict[str, np.ndarray]:
+    """Every array of the ``.npz`` file at path; a truncated or garbled file gives a one-line
+    error naming it and what to do."""
+    path = Path(path)
+    try:
+        with np.load(path) as z:
+            return {k: z[k] for k in z.files}
+    except (zipfile.BadZipFile, zlib.error, EOFError, OSError, ValueError, KeyError) as err:
+        raise InputError(f"{path} is unreadable ({type(err).__name__}: {err}); delete {path.parent} to compute "
+                         "that run again, or resume without it") from None
+
+
 def load_arrays(directory: str | Path, name: str = CHECKPOINT) -> dict[str, np.ndarray]:
-    """The arrays of ``DIR/name``."""
+    """The arrays of ``DIR/name`` (logged as a resume, with its step, on logger ``rkfx``)."""
     path = Path(directory) / name
     if not path.is_file():
         raise InputError(f"no checkpoint at {str(path)!r}; run with a checkpoint interval and folder first")
-    with np.load(path) as z:
-        return {k: z[k] for k in z.files}
+    arrays = read_arrays(path)
+    step = next((int(v) for k, v in arrays.items() if k.split("__")[-1] == "step" and np.ndim(v) == 0), None)
+    log.info("resume: %s continues from step %s", Path(directory).name, "?" if step is None else step)
+    return arrays
 
 
 def prefixed(arrays: Mapping[str, np.ndarray], prefix: str) -> dict[str, np.ndarray]:
