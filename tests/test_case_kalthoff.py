@@ -151,3 +151,20 @@ def test_resume_without_out_completes_the_resumed_folder(tmp_path, monkeypatch):
     kalthoff.main(["--method", "rkpm", "--resume", str(tmp_path)])
     assert seen["work_dir"] == tmp_path / "checkpoints" and seen["resume"] == tmp_path / "checkpoints"
     assert (tmp_path / "results.json").is_file()
+
+
+def test_a_failed_run_leaves_no_earlier_outputs_beside_it(tmp_path, monkeypatch, capsys):
+    out = tmp_path / "k"
+    out.mkdir()
+    (out / "results.json").write_text("{}")
+    (out / "damage.png").write_bytes(b"png")
+
+    def failing_run(**kw):
+        raise kalthoff.InputError("the solver diverged")
+
+    monkeypatch.setattr(kalthoff, "run", failing_run)
+    with pytest.raises(SystemExit):
+        kalthoff.main(["--method", "rkpm", "--out", str(out)])
+    assert not (out / "results.json").exists() and not (out / "damage.png").exists()
+    assert (out / "previous" / "results.json").read_text() == "{}"
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1  # the error, nothing else

@@ -245,6 +245,8 @@ def main(name: str, doc: str | None, specs: Mapping[str, Param], run: Callable[.
                      "resume": None if args.resume is None else args.resume / "checkpoints"}
         check_out(args.out, raw=argv if argv is not None else sys.argv[1:])
         _report_resumes(args.resume if checkpoints else None)
+        if _rank() == 0:
+            set_aside_previous(args.out)
         world = comm()
         if world is not None and world.size > 1:
             share_cores(world)  # ranks x threads <= cores
@@ -292,6 +294,24 @@ def _report_resumes(resume: Path | None) -> None:
     handler.rkfx_resume = True
     log.addHandler(handler)
     log.setLevel(logging.INFO)
+
+
+def set_aside_previous(out: Path) -> list[Path]:
+    """Move the results.json and figures of an earlier run in ``out`` to ``out/previous/``, so that
+    a run that fails leaves no outputs that could be taken for its own; returns what moved."""
+    out = Path(out)
+    stale = [f for f in [out / "results.json", *sorted(out.glob("*.png"))] if f.is_file()] if out.is_dir() else []
+    if not stale:
+        return []
+    previous = out / "previous"
+    if previous.is_dir():
+        for f in previous.iterdir():
+            if f.is_file():
+                f.unlink()
+    previous.mkdir(exist_ok=True)
+    for f in stale:
+        f.replace(previous / f.name)
+    return [previous / f.name for f in stale]
 
 
 def check_out(out: Path, raw: Sequence[str] = ()) -> None:
