@@ -123,6 +123,7 @@ def test_two_level_rates():
     ("rules=mscni,foo", ["rules", "foo"]),
     ("h=-1", ["h"]),
     ("L=0.5", ["L"]),
+    ("a=6", ["a = 6", "lower a"]),
 ])
 def test_bad_parameters_exit_2_with_one_line(setting, names, tmp_path, capsys):
     with pytest.raises(SystemExit) as exc:

@@ -71,11 +71,13 @@ PARAMS = {
 }
 QUICK = {"h": 0.5, "levels": 1}
 
+
 def _validate(a, L, h, levels, T, rules, bc_method, fem_degrees):
     if not a > 0:
         raise InputError(f"a = {a!r}: the hole radius must be positive")
     if not L > a:
-        raise InputError(f"L = {L!r}: the plate side must exceed the hole radius a = {a!r}")
+        raise InputError(f"a = {a!r}, L = {L!r}: the hole radius a must be smaller than the plate side L; "
+                         "lower a or raise L")
     if not 0 < h <= L - a:
         raise InputError(f"h = {h!r}: the mesh size must lie in (0, L - a] = (0, {L - a:g}]")
     if levels < 1:
