@@ -81,7 +81,8 @@ from rkfx.fracture import damage as dm
 from rkfx.errors import InputError
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.assembly.smeared_strain import dilatational_wave_speed
-from rkfx.models.damage_dynamics import DamageRun, run_damage, run_key
+from rkfx.models.damage_dynamics import DamageRun, run_damage
+from rkfx.solvers.checkpoint import run_folder
 from rkfx.parallel.ranks import on_root
 from rkfx.solvers.central_difference import Constraint
 
@@ -419,7 +420,7 @@ def _crack_band(mesh, material: dm.DamageMaterial, rho: float, t_end: float, reg
     external_force)`` sets up the problem's loads. A finished run in ``io["resume"]`` is read
     back with its mesh's nodes and cells, without meshing again."""
     work_dir, resume = io.get("work_dir"), io.get("resume")
-    done = None if resume is None else Path(resume) / run_key(label)
+    done = None if resume is None else Path(resume) / run_folder(label)
     if done is not None and (done / "result.npz").is_file() and (done / MESH_FILE).is_file():
         with np.load(done / MESH_FILE) as z:
             x, tri, h = z["x"], z["triangles"], float(z["h"])
@@ -444,7 +445,7 @@ def _crack_band(mesh, material: dm.DamageMaterial, rho: float, t_end: float, reg
                      work_dir=None if work_dir is None else Path(work_dir),
                      resume=None if resume is None else Path(resume))
     if work_dir is not None:  # beside result.npz, so that a resume reads the run back without meshing
-        folder = Path(work_dir) / run_key(label)
+        folder = Path(work_dir) / run_folder(label)
         folder.mkdir(parents=True, exist_ok=True)  # a run read back from elsewhere wrote nothing here
         np.savez(folder / MESH_FILE, x=m.x, triangles=m.triangles, h=m.h)
     return DynamicCrackBandResult(m.num_nodes, m.num_cells, m.h, run, m.centroids, m.x, m.triangles,

@@ -169,7 +169,7 @@ def test_cli_checkpoint_errors_exit_2_with_one_line(capsys, tmp_path):
     assert cracked_bar.main([*small, "--checkpoint-every", "5", "--out", str(tmp_path / "a")]) == 0
     capsys.readouterr()
     for args, name in ((["--checkpoint-every", "-1"], "checkpoint-every"), (["--resume", str(tmp_path / "none")], "resume"),
-                       ([*small[:-1], "steps=9", "--resume", str(tmp_path / "a")], "other load targets")):
+                       ([*small[:-1], "steps=9", "--resume", str(tmp_path / "a")], "steps = 8 (now 9)")):
         with pytest.raises(SystemExit) as e:
             cracked_bar.main([*args, "--out", str(tmp_path / "b")])
         err = capsys.readouterr().err

@@ -15,12 +15,18 @@ Results go to ``DIR/results.json`` (default ``results/<name>/``) with the schema
                "series": {...}, "errors": {...}, "info": {...}}]}
 
 (numpy arrays become lists; non-finite floats become null).
+
+Cases with checkpoints keep their runs' files in ``DIR/checkpoints/<run>/`` with the
+fingerprint of the invocation (``fingerprint.json``: case, rkfx version, method, parameters).
+``--resume DIR`` refuses, in one line naming the differing values, to read back runs computed
+with other parameters, unless ``--recompute`` asks to compute them again.
 """
 import argparse
 import json
 import logging
 import math
 import os
+import shutil
 import sys
 import textwrap
 from collections.abc import Callable, Iterable, Mapping, Sequence
@@ -32,6 +38,7 @@ import numpy as np
 
 from rkfx.errors import InputError, SolverError
 from rkfx.parallel.threads import share_cores
+from rkfx.solvers.checkpoint import has_checkpoint, run_folder
 from rkfx.warmup import warm_up
 
 METHODS = {"rkpm": ("rkpm",), "fem": ("fem",), "both": ("rkpm", "fem")}
@@ -39,10 +46,16 @@ METHODS = {"rkpm": ("rkpm",), "fem": ("fem",), "both": ("rkpm", "fem")}
 
 @dataclass(frozen=True)
 class Param:
-    """A documented case parameter: its default (which fixes its type) and a one-line doc."""
+    """A documented case parameter: its default (which fixes its type) and a one-line doc.
+
+    ``fingerprint=False`` marks a value that only chooses which runs exist (a list of levels or
+    variants, each run stored under its own label): a resume may change it and keeps the
+    stored runs. Every other value is part of the fingerprint of the stored runs.
+    """
 
     default: Any
     doc: str
+    fingerprint: bool = True
 
 
 @dataclass
@@ -185,6 +198,9 @@ def build_parser(name: str, doc: str | None, specs: Mapping[str, Param],
         parser.add_argument("--resume", type=Path, default=None, metavar="DIR",
                             help="continue a killed run from the output directory DIR: finished models are "
                                  "read back, the interrupted one continues from its last checkpoint")
+        parser.add_argument("--recompute", action="store_true",
+                            help="with --resume: when DIR's runs were computed with other parameters or another "
+                                 "rkfx, compute them again (DIR's checkpoints move to DIR/previous/)")
     return parser
 
 
@@ -205,11 +221,11 @@ class Checkpoints:
     def for_run(self, key: str) -> dict:
         """``checkpoint_every``, ``checkpoint_dir`` and ``resume`` for the solver of one run: a run
         that had a checkpoint (finished or not) continues from it, the others start afresh."""
-        folder = key.replace(" ", "_").replace("=", "").replace("/", "-")
+        folder = run_folder(key)
         ck_dir = None if not self.every or self.work_dir is None else Path(self.work_dir) / folder
         old = None if self.resume is None else Path(self.resume) / folder
         return {"checkpoint_every": self.every, "checkpoint_dir": ck_dir,
-                "resume": old if old is not None and (old / "checkpoint.npz").is_file() else None}
+                "resume": old if has_checkpoint(old) else None}
 
 
 def _fmt_value(v):
@@ -241,17 +257,29 @@ def main(name: str, doc: str | None, specs: Mapping[str, Param], run: Callable[.
             if args.resume is not None and not (args.resume / "checkpoints").is_dir():
                 raise ParameterError(f"--resume {args.resume}: no checkpoints/ folder there; give the --out "
                                      "directory of the interrupted run")
+            if args.recompute and args.resume is None:
+                raise ParameterError("--recompute: give --resume DIR, the folder whose runs to compute again")
             extra = {"checkpoint_every": args.checkpoint_every, "work_dir": Path(args.out) / "checkpoints",
                      "resume": None if args.resume is None else args.resume / "checkpoints"}
         check_out(args.out, raw=argv if argv is not None else sys.argv[1:])
         _report_resumes(args.resume if checkpoints else None)
+        stamp = fingerprint(name, specs, params, args.method) if checkpoints else None
+        if checkpoints and args.resume is not None and not check_resume(args.resume, stamp, args.recompute):
+            extra["resume"] = None  # --recompute: every stored run differs
+            if _same(args.resume, args.out) and _rank() == 0:
+                set_aside_checkpoints(args.out)
         if _rank() == 0:
             set_aside_previous(args.out)
+        stamped = write_fingerprint(Path(args.out) / "checkpoints", stamp) if checkpoints and _rank() == 0 else []
         world = comm()
         if world is not None and world.size > 1:
             share_cores(world)  # ranks x threads <= cores
         warm_up()  # wall times below measure the methods, not the JIT compiler
-        results = run(methods=METHODS[args.method], **params, **extra)
+        try:
+            results = run(methods=METHODS[args.method], **params, **extra)
+        except (InputError, SolverError):
+            _unstamp(stamped)
+            raise
     except (InputError, SolverError) as err:
         _fail(parser.prog, err)
     if _rank() != 0:
@@ -284,16 +312,121 @@ def jsonable(obj: Any) -> Any:
     return obj
 
 
+class _Stderr(logging.StreamHandler):
+    """A log handler on whatever ``sys.stderr`` is when a record comes (it may be replaced)."""
+
+    @property
+    def stream(self):
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, _):
+        pass
+
+
 def _report_resumes(resume: Path | None) -> None:
     """With ``--resume``, say on stderr (rank 0) which runs are read back and where each continues."""
     log = logging.getLogger("rkfx")
     if resume is None or _rank() != 0 or any(getattr(h, "rkfx_resume", False) for h in log.handlers):
         return
-    handler = logging.StreamHandler(sys.stderr)
+    handler = _Stderr()
     handler.setFormatter(logging.Formatter("%(message)s"))
     handler.rkfx_resume = True
     log.addHandler(handler)
     log.setLevel(logging.INFO)
+
+
+FINGERPRINT = "fingerprint.json"  # in OUT/checkpoints: what the stored runs were computed with
+
+
+def fingerprint(case: str, specs: Mapping[str, Param], params: Mapping[str, Any], method: str) -> dict:
+    """What the runs stored under ``OUT/checkpoints`` are computed with: the case, the rkfx
+    version, the ``--method`` and every parameter that is part of the fingerprint (``Param``)."""
+    from rkfx import __version__  # noqa: PLC0415
+
+    return jsonable({"case": case, "rkfx": __version__, "method": method,
+                     "params": {k: params[k] for k, v in specs.items() if v.fingerprint}})
+
+
+def differences(stored: Mapping[str, Any], now: Mapping[str, Any]) -> list[str]:
+    """``name = stored (now new)`` for each fingerprint entry that differs; the method is left
+    out, as each method's runs have their own folders."""
+    out = [f"{k} {stored.get(k)} (now {now[k]})" for k in ("case", "rkfx") if stored.get(k) != now[k]]
+    old, new = stored.get("params", {}), now["params"]
+    for k in dict.fromkeys([*new, *old]):
+        if k not in old or k not in new or old[k] != new[k]:
+            out.append(f"{k} = {_fmt_value(old.get(k, 'unset'))} (now {_fmt_value(new.get(k, 'unset'))})")
+    return out
+
+
+def check_resume(resume: Path, stamp: Mapping[str, Any], recompute: bool) -> bool:
+    """Whether the runs stored in ``resume/checkpoints`` were computed with ``stamp``; if not,
+    ``False`` with ``recompute``, else a one-line error naming the differing parameters."""
+    folder = Path(resume) / "checkpoints"
+    path = folder / FINGERPRINT
+    stored_runs = [d for d in folder.iterdir() if d.is_dir()] if folder.is_dir() else []
+    if path.is_file():
+        try:
+            diff = differences(json.loads(path.read_text()), stamp)
+        except (ValueError, AttributeError):
+            diff = [f"{path} is unreadable"]
+    else:
+        diff = [f"{folder} has no {FINGERPRINT} (written by an older rkfx)"] if stored_runs else []
+    if not diff:
+        return True
+    if recompute:
+        logging.getLogger("rkfx").info("resume: %s differs: %s; computing every run again", resume, "; ".join(diff))
+        return False
+    raise ParameterError(f"--resume {resume}: its runs were computed with {'; '.join(diff)}; resume with the same "
+                         "--set values, or add --recompute to compute them again")
+
+
+def write_fingerprint(folder: Path, stamp: Mapping[str, Any]) -> list[Path]:
+    """Write ``folder/fingerprint.json``; returns what was created here (for ``_unstamp``)."""
+    folder = Path(folder)
+    made = []
+    missing = folder
+    while not missing.exists():
+        made.insert(0, missing)
+        missing = missing.parent
+    path = folder / FINGERPRINT
+    if not path.exists():
+        made.append(path)
+    folder.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(json.dumps(stamp, indent=1) + "\n")
+    tmp.replace(path)
+    return made
+
+
+def _unstamp(made: Sequence[Path]) -> None:
+    """Remove the fingerprint and folder ``write_fingerprint`` created when the run stored nothing
+    beside them (it stopped on bad input), so that bad input leaves nothing behind."""
+    for path in reversed(made):
+        if path.is_file():
+            if any(f != path for f in path.parent.iterdir()):
+                return
+            path.unlink()
+        elif path.is_dir() and not any(path.iterdir()):
+            path.rmdir()
+
+
+def _same(a: Path, b: Path) -> bool:
+    return Path(a).resolve() == Path(b).resolve()
+
+
+def set_aside_checkpoints(out: Path) -> Path | None:
+    """Move ``out/checkpoints`` to ``out/previous/checkpoints`` (replacing an older one there):
+    runs to be computed again must not be read back by a later resume, nor be lost."""
+    folder = Path(out) / "checkpoints"
+    if not folder.is_dir():
+        return None
+    target = Path(out) / "previous" / "checkpoints"
+    if target.is_dir():
+        shutil.rmtree(target)
+    target.parent.mkdir(exist_ok=True)
+    folder.replace(target)
+    return target
 
 
 def set_aside_previous(out: Path) -> list[Path]:

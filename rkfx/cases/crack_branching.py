@@ -85,7 +85,7 @@ PARAMS = {
     "tol": Param(0.5, "particle tracking tolerance of (4.22)"),
     "h": Param([8e-4, 4e-4, 2e-4], "nominal nodal spacings of the regularized models [m]"),
     "unregularized_h": Param([8e-4, 4e-4, 2e-4], "nominal nodal spacings of the constant-kappa_c models [m]"),
-    "fem_h": Param([8e-4, 4e-4, 2e-4], "element sizes of the crack-band finite element baseline [m]"),
+    "fem_h": Param([8e-4, 4e-4, 2e-4], "element sizes of the crack-band finite element baseline [m]", fingerprint=False),
     "support_factor": Param(1.75, "RK support radius / nodal spacing (>= 1.6: see rkfx.cases.kalthoff)"),
     "courant": Param(0.5, "dt = courant * h / c_d"),
     "radius": Param(3.5, "tracking neighbourhood radius / nodal spacing"),

@@ -114,7 +114,6 @@ from rkfx.models.damage_bar import (
     strip,
 )
 from rkfx.errors import InputError, SolverError
-from rkfx.solvers.checkpoint import CHECKPOINT
 from rkfx.solvers.newton import NewtonOptions
 from rkfx.solvers.quasi_static import QuasiStatic, march
 from rkfx.cases import _cli
@@ -129,13 +128,13 @@ PARAMS = {
     "ft": Param(200.0, "tensile strength f_t (kappa0 = ft / E)"),
     "L": Param(100.0, "bar length"),
     "A": Param(10.0, "cross-section area"),
-    "nodes": Param([16, 32, 64, 128], "nodes along the bar axis (even: x = L/2 between two node columns)"),
+    "nodes": Param([16, 32, 64, 128], "nodes along the bar axis (even: x = L/2 between two node columns)", fingerprint=False),
     "weak_factor": Param(0.999, "kappa0 multiplier of the particles at x = L/2"),
     "steps": Param(100, "load steps from the elastic limit to u_end"),
     "u_end": Param(1.02, "last tip displacement / w_c"),
     "stress_at": Param(0.2, "Fig 4.11 snapshot: u_T = u_peak + stress_at (w_c - u_peak)"),
     "support_factor": Param(1.5, "RK support radius / nodal spacing"),
-    "cells": Param(list(CELLS), "SCNI nodal cells of the regularized model: voronoi, median-dual"),
+    "cells": Param(list(CELLS), "SCNI nodal cells of the regularized model: voronoi, median-dual", fingerprint=False),
 }
 QUICK = {"nodes": [16, 32], "cells": ["voronoi"], "steps": 60}
 
@@ -274,21 +273,11 @@ def _reference(u, prm) -> dict:
     return {"F_czm": bar.force(u), "w_czm": bar.opening(u)}
 
 
-def _io(label: str, io: dict) -> dict:
-    """The checkpoint arguments of one load path: its folder ``label`` (spaces and '=' dropped)
-    under the work directory, and the checkpoint to resume from if the interrupted run left one."""
-    key = label.replace(" ", "_").replace("=", "")
-    resume = io.get("resume")
-    resume = Path(resume) / key if resume is not None and (Path(resume) / key / CHECKPOINT).is_file() else None
-    every, work = io.get("checkpoint_every", 0), io.get("work_dir")
-    return {"checkpoint_every": every, "checkpoint_dir": None if work is None else Path(work) / key, "resume": resume}
-
-
 def _run_scni(label, s, model, targets, prm, info, stress_u=None, io=None) -> Run:
     """One SCNI load path with its curves, profile at u_T = w_c and (optionally) stresses."""
     wc = 2 * prm["GF"] / prm["ft"]
     snapshots = [wc] + ([stress_u] if stress_u is not None else [])
-    path = load_path(s, model, targets, snapshots, **_io(label, io or {}))
+    path = load_path(s, model, targets, snapshots, **(io.for_run(label) if io is not None else {}))
     if model.regularized:
         dm.check_regularization(model, path.state)
     errors = _curve_errors(path.u, path.force, path.dissipated, path.elastic, prm)
@@ -318,7 +307,7 @@ def _run_gauss(n, prm, stress_u, targets, io=None) -> Run:
     t0 = time.perf_counter()
     label = f"rkpm-gauss{GAUSS_ALONG}x{GAUSS_ACROSS} n={n}"
     try:
-        path = load_path(s, model, targets[targets < stress_u], [stress_u], **_io(label, io or {}))
+        path = load_path(s, model, targets[targets < stress_u], [stress_u], **(io.for_run(label) if io is not None else {}))
         sig, reached, its = path.snapshots[stress_u][0][:, 0], stress_u, path.iterations
     except SolverError:  # the seed: Gauss stresses "could ... cause divergence"
         sig, reached, its = np.full(len(s.points), np.nan), float("nan"), 0
@@ -340,7 +329,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=2.0e6, GF=1.885, ft=200.0
     nodes, cells = [int(n) for n in nodes], list(cells)
     if checkpoint_every and work_dir is None:
         raise InputError("checkpoint_every needs a work directory (the case's --out)")
-    io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume}
+    io = _cli.Checkpoints(checkpoint_every, work_dir, resume)
     _check(E, GF, ft, L, A, nodes, weak_factor, steps, u_end, stress_at, support_factor, cells)
     material = dm.DamageMaterial(E, 0.0, ft, GF, "stress")
     wc = material.critical_opening
@@ -387,7 +376,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=2.0e6, GF=1.885, ft=200.0
         for n in _cli.progress(nodes, "fem-crack-band"):
             u_peak = weak_factor * ft * L / E
             res = solve_crack_band(L, A, E, GF, ft, n - 1, _targets(u_peak, wc, steps, u_end, weak_factor),
-                                   weak_factor=weak_factor, u_profile=wc, **_io(f"fem-crack-band n={n}", io))
+                                   weak_factor=weak_factor, u_profile=wc, **io.for_run(f"fem-crack-band n={n}"))
             errors = _curve_errors(res.u, res.force, res.dissipated, res.elastic, prm)
             col_of = np.round(res.x / res.h - 0.5).astype(int)  # triangle centroids at 1/3 and 2/3 of a column
             column = np.arange(col_of.max() + 1)

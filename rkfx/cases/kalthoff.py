@@ -84,14 +84,15 @@ PARAMS = {
     "tol": Param(0.3, "particle tracking tolerance of (4.22)"),
     "nodes": Param([150, 250, 350, 450], "particles per side of the regularized models"),
     "unregularized_nodes": Param([150, 250, 350], "particles per side of the constant-kappa_c models"),
-    "no_tracking_nodes": Param([150, 250], "particles per side of the models without tracking"),
-    "fem_nodes": Param([150, 250], "crack-band FEM: element size 0.1 / (n - 1)"),
+    "no_tracking_nodes": Param([150, 250], "particles per side of the models without tracking", fingerprint=False),
+    "fem_nodes": Param([150, 250], "crack-band FEM: element size 0.1 / (n - 1)", fingerprint=False),
     "support_factor": Param(1.75, "RK support radius / nodal spacing (>= 1.6: see the module docstring)"),
     "courant": Param(0.5, "dt = courant * h / c_d"),
     "radius": Param(3.5, "tracking neighbourhood radius / nodal spacing"),
     "forward": Param(True, "tracking: candidates only ahead of their particle (false: (4.22) both ways)"),
     "eps_p": Param(1.0, "weight of the MSCNI stabilization (0: plain SCNI)"),
-    "angle_radius": Param(0.1, "crack-angle fit: cracked particles within this distance of the tip [m]"),
+    "angle_radius": Param(0.1, "crack-angle fit: cracked particles within this distance of the tip [m]",
+                          fingerprint=False),
 }
 QUICK = {"nodes": [60, 90, 120], "unregularized_nodes": [60, 120], "no_tracking_nodes": [90], "fem_nodes": [60]}
 

@@ -78,9 +78,9 @@ PARAMS = {
     "dt_D": Param(0.01, "first time step c dt / h^2 of the profiles study [-]"),
     "growth": Param(1.6, "step growth factor every 10 steps in the profiles study [-]"),
     "t_D": Param([0.01, 0.1, 0.5, 1.0], "output times c t / Lx^2 [-]"),
-    "variants": Param(["scni+fpp", "ni"], "RKPM variants of the profiles study"),
-    "early_variants": Param(list(VARIANTS), "RKPM variants of the early-time study"),
-    "fem": Param(list(FEM_ELEMENTS), "FEM elements: taylor-hood, q1q1, q1q1-fpp"),
+    "variants": Param(["scni+fpp", "ni"], "RKPM variants of the profiles study", fingerprint=False),
+    "early_variants": Param(list(VARIANTS), "RKPM variants of the early-time study", fingerprint=False),
+    "fem": Param(list(FEM_ELEMENTS), "FEM elements: taylor-hood, q1q1, q1q1-fpp", fingerprint=False),
     "support_factor": Param(1.5, "RK support radius / nodal spacing [-]"),
 }
 QUICK = {"nx": 41, "ny": 5, "t_D": [0.01, 0.1], "early_variants": ["ni", "scni+fpp"],

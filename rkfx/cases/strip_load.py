@@ -74,9 +74,9 @@ PARAMS = {
     "t_D_end": Param(2.0, "end of the pressure history [-]"),
     "depth_history": Param(0.2, "depth of the history point on the axis [m]"),
     "steps_low": Param(4, "time steps of the low-permeability study"),
-    "variants": Param(["scni+fpp", "ni"], "RKPM variants of the drained study"),
-    "low_variants": Param(["ni", "scni+fpp"], "RKPM variants of the low-permeability study"),
-    "fem": Param(["taylor-hood", "q1q1-fpp"], "FEM elements: taylor-hood, q1q1, q1q1-fpp"),
+    "variants": Param(["scni+fpp", "ni"], "RKPM variants of the drained study", fingerprint=False),
+    "low_variants": Param(["ni", "scni+fpp"], "RKPM variants of the low-permeability study", fingerprint=False),
+    "fem": Param(["taylor-hood", "q1q1-fpp"], "FEM elements: taylor-hood, q1q1, q1q1-fpp", fingerprint=False),
     "support_factor": Param(1.5, "RK support radius / nodal spacing [-]"),
 }
 QUICK = {"nx": 21, "ny": 21, "t_D_end": 0.5, "fem": ["taylor-hood"]}

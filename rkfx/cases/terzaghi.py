@@ -75,9 +75,9 @@ PARAMS = {
     "t_end": Param(1.0, "last output time [s] (always an output)"),
     "t_out": Param([], "further output times [s]"),
     "growth": Param(1.5, "step growth factor every 10 steps after the first [-]"),
-    "variants": Param(list(VARIANTS), "RKPM variants"),
-    "fem": Param(list(FEM_ELEMENTS), "FEM elements: taylor-hood, q1q1, q1q1-fpp"),
-    "refine_ny": Param([21, 41, 81], "nodes along the height of the refinement study"),
+    "variants": Param(list(VARIANTS), "RKPM variants", fingerprint=False),
+    "fem": Param(list(FEM_ELEMENTS), "FEM elements: taylor-hood, q1q1, q1q1-fpp", fingerprint=False),
+    "refine_ny": Param([21, 41, 81], "nodes along the height of the refinement study", fingerprint=False),
     "support_factor": Param(1.5, "RK support radius / nodal spacing [-]"),
 }
 QUICK = {"refine_ny": [21, 41], "fem": ["taylor-hood", "q1q1-fpp"]}

@@ -60,7 +60,7 @@ from rkfx.materials.damage_law import damage_kernel, strain_kernel
 from rkfx.errors import InputError
 from rkfx.parallel.ranks import on_root
 from rkfx.solvers.central_difference import CentralDifference, Constraint, ExplicitDynamics, ExplicitState
-from rkfx.solvers.checkpoint import copy_into, log, read_arrays
+from rkfx.solvers.checkpoint import copy_into, has_checkpoint, log, read_arrays, run_folder, save_arrays
 
 HISTORY = ("time", "dissipated", "damaged", "kinetic", "internal", "external")
 
@@ -304,13 +304,11 @@ class DamageRun:
         return self.history[:, HISTORY.index(name)]
 
     def save(self, path: Path) -> None:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_suffix(".tmp.npz")
-        np.savez(tmp, history=self.history, damage=self.damage, kappa=self.kappa, normal=self.normal,
-                 initiation_time=self.initiation_time, opening=self.opening, dissipation=self.dissipation,
-                 displacement=self.displacement, velocity=self.velocity, steps=self.steps, dt=self.dt,
-                 wall_time_s=self.wall_time_s, energy_error=self.energy_error, label=self.label)
-        tmp.replace(path)
+        save_arrays(path.parent, dict(
+            history=self.history, damage=self.damage, kappa=self.kappa, normal=self.normal,
+            initiation_time=self.initiation_time, opening=self.opening, dissipation=self.dissipation,
+            displacement=self.displacement, velocity=self.velocity, steps=self.steps, dt=self.dt,
+            wall_time_s=self.wall_time_s, energy_error=self.energy_error, label=self.label), name=path.name)
 
     @classmethod
     def load(cls, path: Path) -> "DamageRun":
@@ -320,11 +318,6 @@ class DamageRun:
         return cls(str(z["label"]), z["history"], z["damage"], z["kappa"], z["normal"], z["initiation_time"],
                    z["opening"], z["dissipation"], z["displacement"], z["velocity"], int(z["steps"]),
                    float(z["dt"]), float(z["wall_time_s"]), float(z["energy_error"]))
-
-
-def run_key(label: str) -> str:
-    """The folder of a run's files (result, checkpoint) in a work directory."""
-    return label.replace(" ", "_").replace("=", "")
 
 
 def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, model: DamageModel,
@@ -356,16 +349,24 @@ def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, mode
         raise InputError(f"t_end = {t_end!r} must be positive (seconds)")
     if checkpoint_every and work_dir is None:
         raise InputError("checkpoint_every needs a work directory (the case's --out)")
-    key = run_key(label)
-    if resume is not None and (Path(resume) / key / "result.npz").is_file():
-        done = DamageRun.load(Path(resume) / key / "result.npz")
-        log.info("resume: %s read back finished (%s)", label, Path(resume) / key / "result.npz")
-        return done
+    key = run_folder(label)
+    finished = None if resume is None else Path(resume) / key / "result.npz"
+    if finished is not None and finished.is_file():
+        try:
+            done = DamageRun.load(finished)
+        except InputError as err:
+            if not has_checkpoint(finished.parent):
+                raise
+            # The run goes on from its last checkpoint to the same result.
+            log.warning("resume: %s; continuing %s from its checkpoint", str(err).split(";")[0], label)
+        else:
+            log.info("resume: %s read back finished (%s)", label, finished)
+            return done
     steps = int(np.ceil(t_end / dt - 1e-9))
     every = max(1, steps // samples)
     start = None
     checkpoint_dir = None if work_dir is None else Path(work_dir) / key
-    if resume is not None and (Path(resume) / key / "checkpoint.npz").is_file():
+    if resume is not None and has_checkpoint(Path(resume) / key):
         start = Path(resume) / key
     dynamics = DamageDynamics(op, mass, model, track, dt, constraints, external_force)
     kept = _Samples(dynamics, steps, every)

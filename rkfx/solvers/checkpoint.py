@@ -1,7 +1,14 @@
 """Checkpoint files: named arrays written atomically, so an interrupted run never leaves a
-half-written checkpoint (temporary file, fsync, then ``os.replace``)."""
+half-written checkpoint (temporary file, fsync, then ``os.replace``).
+
+A checkpoint folder keeps the last two checkpoints: ``checkpoint.npz`` and, before it,
+``checkpoint.previous.npz``. A resume reads the newest; when that one is unreadable (a disk
+that filled up, a file damaged after it was written) it says so and falls back to the
+previous one, from which the deterministic run reaches the same result.
+"""
 import logging
 import os
+import shutil
 import sys
 import zipfile
 import zlib
@@ -13,6 +20,7 @@ import numpy as np
 from rkfx.errors import InputError
 
 CHECKPOINT = "checkpoint.npz"
+PREVIOUS = "checkpoint.previous.npz"  # the checkpoint before the newest
 log = logging.getLogger("rkfx")
 
 
@@ -27,7 +35,11 @@ def writes(comm) -> bool:
 
 def save_arrays(directory: str | Path, arrays: Mapping[str, np.ndarray], name: str = CHECKPOINT,
                 comm=None) -> Path:
-    """Write ``DIR/name`` atomically (on one rank of ``comm``, see ``writes``); returns its path."""
+    """Write ``DIR/name`` atomically (on one rank of ``comm``, see ``writes``); returns its path.
+
+    A new checkpoint (``name`` = ``CHECKPOINT``) first keeps the one it replaces as ``PREVIOUS``,
+    so that at every instant the folder holds a complete newest checkpoint.
+    """
     directory = Path(directory)
     if not writes(comm):
         return directory / name
@@ -38,8 +50,33 @@ def save_arrays(directory: str | Path, arrays: Mapping[str, np.ndarray], name: s
         np.savez(fh, **{k: np.asarray(v) for k, v in arrays.items()})
         fh.flush()
         os.fsync(fh.fileno())
+    if name == CHECKPOINT and target.is_file():
+        _keep_as_previous(target, directory / PREVIOUS)
     os.replace(tmp, target)
     return target
+
+
+def _keep_as_previous(target: Path, previous: Path) -> None:
+    """``target`` also under the name ``previous``: a hard link renamed into place, so ``target``
+    never goes missing (a copy where the file system has no links)."""
+    tmp = previous.with_name(previous.name + ".tmp")
+    tmp.unlink(missing_ok=True)
+    try:
+        os.link(target, tmp)
+    except OSError:
+        shutil.copyfile(target, tmp)
+    os.replace(tmp, previous)
+
+
+def run_folder(label: str) -> str:
+    """The folder of a run's files (checkpoints, finished result) in a work directory: its label
+    with spaces as '_', '/' as '-' and '=' dropped (``"rkpm-dpm n=150"`` -> ``rkpm-dpm_n150``)."""
+    return label.replace(" ", "_").replace("=", "").replace("/", "-")
+
+
+def has_checkpoint(directory: str | Path | None) -> bool:
+    """Whether ``directory`` holds a checkpoint to resume from (the newest or the previous one)."""
+    return directory is not None and any((Path(directory) / n).is_file() for n in (CHECKPOINT, PREVIOUS))
 
 
 def read_arrays(path: str | Path) -> dict[str, np.ndarray]:
@@ -50,18 +87,33 @@ def read_arrays(path: str | Path) -> dict[str, np.ndarray]:
         with np.load(path) as z:
             return {k: z[k] for k in z.files}
     except (zipfile.BadZipFile, zlib.error, EOFError, OSError, ValueError, KeyError) as err:
-        raise InputError(f"{path} is unreadable ({type(err).__name__}: {err}); delete {path.parent} to compute "
+        why = str(err).split(". ")[0][:80]
+        raise InputError(f"{path} is unreadable ({type(err).__name__}: {why}); delete {path.parent} to compute "
                          "that run again, or resume without it") from None
 
 
-def load_arrays(directory: str | Path, name: str = CHECKPOINT) -> dict[str, np.ndarray]:
-    """The arrays of ``DIR/name`` (logged as a resume, with its step, on logger ``rkfx``)."""
-    path = Path(directory) / name
-    if not path.is_file():
-        raise InputError(f"no checkpoint at {str(path)!r}; run with a checkpoint interval and folder first")
-    arrays = read_arrays(path)
+def load_arrays(directory: str | Path) -> dict[str, np.ndarray]:
+    """The arrays of the newest readable checkpoint in ``directory`` (logged as a resume, with its
+    step, on logger ``rkfx``): ``CHECKPOINT``, else ``PREVIOUS`` with a warning naming why."""
+    directory = Path(directory)
+    newest, previous = directory / CHECKPOINT, directory / PREVIOUS
+    if not has_checkpoint(directory):
+        raise InputError(f"no checkpoint at {str(newest)!r}; run with a checkpoint interval and folder first")
+    try:
+        arrays = read_arrays(newest) if newest.is_file() else None
+    except InputError as err:
+        if not previous.is_file():
+            raise
+        log.warning("resume: %s; falling back to %s", str(err).split(";")[0], previous.name)
+        arrays = None
+    if arrays is None:
+        try:
+            arrays = read_arrays(previous)
+        except InputError:
+            raise InputError(f"{newest} and {previous.name} beside it are unreadable; delete {directory} to "
+                             "compute that run again") from None
     step = next((int(v) for k, v in arrays.items() if k.split("__")[-1] == "step" and np.ndim(v) == 0), None)
-    log.info("resume: %s continues from step %s", Path(directory).name, "?" if step is None else step)
+    log.info("resume: %s continues from step %s", directory.name, "?" if step is None else step)
     return arrays
 
 

@@ -1,0 +1,69 @@
+"""Run a small Kalthoff model through the CLI and SIGKILL the process at a chosen point.
+
+    python tests/faults/killed_run.py OUT POINT N
+
+POINT is where the process dies:
+    after-checkpoint  right after the N-th checkpoint is in place;
+    mid-checkpoint    half-way through writing the N-th checkpoint's temporary file;
+    mid-previous      after the N-th checkpoint's predecessor became checkpoint.previous.npz,
+                      before the new one replaces checkpoint.npz;
+    mid-result        half-way through writing a finished run's result.npz (N-th run);
+    never             run to the end.
+"""
+import io
+import os
+import signal
+import sys
+
+import numpy as np
+
+from rkfx.cases import kalthoff
+from rkfx.solvers import checkpoint
+
+ARGS = ["--method", "rkpm", "--set", "nodes=40", "unregularized_nodes=40", "no_tracking_nodes=40", "t_end=2e-5",
+        "--checkpoint-every", "20"]
+
+
+def die():
+    sys.stdout.flush()
+    os.kill(os.getpid(), signal.SIGKILL)
+
+
+def main(out: str, point: str, n: int) -> None:
+    calls = {"checkpoint": 0, "result": 0}
+    savez, replace, keep = np.savez, os.replace, checkpoint._keep_as_previous
+
+    def counted(fh) -> tuple[str, int]:
+        kind = "result" if "result" in getattr(fh, "name", "") else "checkpoint"
+        calls[kind] += 1
+        return kind, calls[kind]
+
+    def half_written(fh, **arrays):
+        kind, k = counted(fh)
+        if (point, k) in (("mid-checkpoint", n), ("mid-result", n)) and kind in point:
+            buf = io.BytesIO()
+            savez(buf, **arrays)
+            fh.write(buf.getvalue()[: len(buf.getvalue()) // 2])
+            fh.flush()
+            os.fsync(fh.fileno())
+            die()
+        savez(fh, **arrays)
+
+    def replaced(src, dst):
+        replace(src, dst)
+        if point == "after-checkpoint" and str(dst).endswith(checkpoint.CHECKPOINT) and calls["checkpoint"] == n:
+            die()
+
+    def kept(target, previous):
+        keep(target, previous)
+        if point == "mid-previous" and calls["checkpoint"] == n:
+            die()
+
+    checkpoint.np.savez = half_written
+    checkpoint.os.replace = replaced
+    checkpoint._keep_as_previous = kept
+    kalthoff.main([*ARGS, "--out", out])
+
+
+if __name__ == "__main__":
+    main(sys.argv[1], sys.argv[2], int(sys.argv[3]))
