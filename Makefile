@@ -22,10 +22,16 @@ bench: $(STAMP)
 
 env: $(STAMP)
 
-$(STAMP): pyproject.toml tools/find-python
+# The last step puts tools/rkfx-mpi.pth and its module into site-packages, so that plain
+# `import dolfinx` finds the mpich wheel's libmpi (why and how: tools/rkfx_mpi_first.py).
+$(STAMP): pyproject.toml tools/find-python tools/rkfx-mpi.pth tools/rkfx_mpi_first.py
 	@test -x $(PY) || { base=$$(tools/find-python) && "$$base" -m venv $(VENV); }
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e ".[all]"
+	site=$$($(PY) -c 'import sysconfig; print(sysconfig.get_path("purelib"))') && \
+	  cp tools/rkfx-mpi.pth "$$site/rkfx-mpi.pth" && \
+	  cp tools/rkfx_mpi_first.py "$$site/_rkfx_mpi_first.py" && \
+	  $(PY) -m compileall -q "$$site/_rkfx_mpi_first.py"
 	@touch $(STAMP)
 
 clean:

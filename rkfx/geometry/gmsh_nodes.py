@@ -4,6 +4,7 @@ The 2-D mesh's vertices become the nodes and its triangles the background triang
 the nodal domains; 1-D physical groups name the boundary parts. Import this module only
 where gmsh is installed (``pip install rkfx[geometry]``).
 """
+import re
 from pathlib import Path
 
 import numpy as np
@@ -70,31 +71,105 @@ def _read(model):
 
 
 def from_geo(path: str | Path, mesh_size: float | None = None, comm=None) -> Particles:
-    """Particles from a gmsh ``.geo`` file, meshed in 2-D (optionally with a global mesh size [m])."""
-    import gmsh  # noqa: PLC0415
+    """Particles from a gmsh ``.geo`` file, meshed in 2-D.
 
+    Args:
+        path: The ``.geo`` script.
+        mesh_size: Optional global maximum mesh size [m].
+        comm: MPI communicator. The file is read on rank 0 and the nodes broadcast.
+
+    Raises:
+        InputError: The file is missing, empty, binary, defines no surface, or gmsh reports an
+            error while reading or meshing it; the message names the file and, where gmsh gives
+            one, the line.
+    """
     path = Path(path)
-    if not path.is_file():
-        raise InputError(f"geometry file {str(path)!r} not found")
+    _check_geo_text(path)
     rank = comm.rank if comm is not None else 0
     data = None
     if rank == 0:
-        started = gmsh.isInitialized()
-        if not started:
-            gmsh.initialize(interruptible=False)
-        gmsh.option.setNumber("General.Terminal", 0)
         try:
-            gmsh.model.add(path.stem)
-            gmsh.merge(str(path))
-            if mesh_size is not None:
-                gmsh.option.setNumber("Mesh.MeshSizeMax", mesh_size)
-                gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
-            gmsh.model.mesh.generate(2)
-            data = _read(gmsh.model)
-            gmsh.model.remove()
-        finally:
-            if not started:
-                gmsh.finalize()
+            data = _mesh_geo(path, mesh_size)
+        except InputError as error:
+            # Handed to every rank, so the others raise too instead of waiting in bcast.
+            data = error
     if comm is not None and comm.size > 1:
         data = comm.bcast(data, root=0)
+    if isinstance(data, InputError):
+        raise data
     return particles(*data)
+
+
+def _check_geo_text(path: Path) -> None:
+    """Refuse what gmsh would misread: a missing, empty or binary file."""
+    if not path.is_file():
+        raise InputError(f"geometry file {str(path)!r} not found")
+    with path.open("rb") as f:
+        head = f.read(8192)
+    # Text never holds NUL or most C0 control bytes; gmsh would "read" such a file silently.
+    if any(b < 32 and b not in b"\t\n\r\f\v" for b in head):
+        raise InputError(f"{path}: not a .geo text file (it holds binary data); "
+                         "pass a gmsh .geo script")
+    if not head.strip():
+        raise InputError(f"{path}: the file is empty, so it defines no surface; "
+                         "write the geometry (points, curves, a Plane Surface) into it")
+
+
+def _mesh_geo(path: Path, mesh_size: float | None):
+    """Read and mesh ``path`` in a gmsh session (the caller's, or one opened here).
+
+    gmsh's logger runs while the file is read; General.Terminal and General.AbortOnError come
+    back as the caller had them.
+    """
+    import gmsh  # noqa: PLC0415
+
+    started = gmsh.isInitialized()
+    if not started:
+        gmsh.initialize(interruptible=False)
+    terminal = gmsh.option.getNumber("General.Terminal")
+    abort = gmsh.option.getNumber("General.AbortOnError")
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.logger.start()
+    try:
+        gmsh.model.add(path.stem)
+        try:
+            # An exception thrown mid-parse leaves the rest of the file in gmsh's lexer, and
+            # every later merge in the process fails on it; without the throw the parser reads
+            # to the end and the errors are only logged.
+            gmsh.option.setNumber("General.AbortOnError", 0)
+            gmsh.merge(str(path))
+        finally:
+            gmsh.option.setNumber("General.AbortOnError", abort)
+        _raise_logged_error(path, gmsh.logger.get(), "")
+        if not gmsh.model.getEntities(2):
+            raise InputError(f"{path}: the file defines no surface; add a Plane Surface to it")
+        if mesh_size is not None:
+            gmsh.option.setNumber("Mesh.MeshSizeMax", mesh_size)
+            gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
+        try:
+            gmsh.model.mesh.generate(2)
+        except Exception:  # noqa: BLE001 - gmsh raises bare Exception; its log says why
+            _raise_logged_error(path, gmsh.logger.get(), "gmsh cannot mesh it: ")
+            raise
+        return _read(gmsh.model)
+    finally:
+        gmsh.logger.stop()
+        gmsh.model.remove()
+        gmsh.option.setNumber("General.Terminal", terminal)
+        if not started:
+            gmsh.finalize()
+
+
+_WHERE = re.compile(r"^'[^']*', line (\d+): ")
+
+
+def _raise_logged_error(path: Path, log: list[str], what: str) -> None:
+    """Raise the first error gmsh logged as one line naming ``path`` and the line, if any."""
+    errors = [m.removeprefix("Error: ") for m in log if m.startswith("Error: ")]
+    if not errors:
+        return
+    # gmsh often logs the cause without a line and then "'file', line N: Could not add ...".
+    line = next((m.group(1) for e in errors if (m := _WHERE.match(e))), None)
+    where = f"{path}:{line}" if line else f"{path}"
+    cause = " ".join(_WHERE.sub("", errors[0]).split())
+    raise InputError(f"{where}: {what}{cause}; fix the file and call from_geo again")
