@@ -270,12 +270,17 @@ def _apply_t(rows_t: SparseRows, stress: np.ndarray, weight: np.ndarray) -> np.n
 _PARTITION_TOL = 1e-9
 
 
+def check_eps_p(eps_p: float) -> None:
+    """Raise InputError unless the MSCNI weight ``eps_p`` is finite and >= 0."""
+    if not (np.isfinite(eps_p) and eps_p >= 0):
+        raise InputError(f"eps_p = {eps_p!r} must be >= 0 (0: plain SCNI, 1: MSCNI)")
+
+
 def smeared_strain(p: Particles, rk: RKApproximation, domains: NodalDomains | None = None,
                    eps_p: float = 0.0) -> SmearedStrain:
     """B~ from the SCNI smoothed gradients on the nodal cells (eq. 3.55 = eq. 4.33), with the
     MSCNI subcell terms of eq. (3.56) when ``eps_p`` > 0 (1 is the usual choice)."""
-    if not (np.isfinite(eps_p) and eps_p >= 0):
-        raise InputError(f"eps_p = {eps_p!r} must be >= 0 (0: plain SCNI, 1: MSCNI)")
+    check_eps_p(eps_p)
     domains = domains or nodal_domains(p)
     volume = np.ascontiguousarray(domains.area, dtype=np.float64)
     if eps_p == 0:

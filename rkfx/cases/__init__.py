@@ -4,7 +4,9 @@
 Each case module states its problem, parameters and units in its docstring and offers a pure
 ``run(...)``, a ``plot(results, out)`` and ``main(argv=None)``; the command-line interface,
 results file (``DIR/results.json``, default ``results/<name>/``) and summary table they share
-live in ``rkfx.cases._cli``.
+live in ``rkfx.cases._cli``. Before any work the command line calls the case's ``check`` (its
+documented parameter ranges) and ``memory_need`` (an estimate of its peak memory, refused when
+the machine cannot hold it), see ``rkfx.cases._preflight``.
 
     plate_with_hole   Kirsch plate with a circular hole under remote tension (plane strain):
                       RKPM (MSCNI / SCNI / DNI) and FEM (P1 / P2) on the same gmsh mesh, errors

@@ -36,6 +36,7 @@ from typing import Any
 
 import numpy as np
 
+from rkfx.cases._preflight import before_work
 from rkfx.errors import InputError, SolverError
 from rkfx.parallel.threads import share_cores
 from rkfx.solvers.checkpoint import has_checkpoint, run_folder
@@ -250,6 +251,7 @@ def main(name: str, doc: str | None, specs: Mapping[str, Param], run: Callable[.
         args.out = getattr(args, "resume", None) or Path("results") / name
     try:
         params = parse_params(specs, args.overrides, quick if args.quick else None)
+        before_work(run, params, METHODS[args.method], comm())  # ranges and memory, before any work
         extra = {}
         if checkpoints:
             if args.checkpoint_every < 0:

@@ -33,6 +33,7 @@ from rkfx.geometry.nodal_domains import NodalDomains
 from rkfx.geometry.particles import Particles, graded
 from rkfx.approximation.shape_functions import RKApproximation, rk_approximation
 from rkfx.solvers.central_difference import Constraint
+from rkfx.cases import _preflight
 
 CRACKED = 0.5  # w / w_c from which a particle counts as cracked (half its fracture energy spent)
 
@@ -66,6 +67,25 @@ class Plate:
     def h(self) -> float:
         """Largest grid spacing [m]."""
         return float(max(np.diff(self.xs).max(), np.diff(self.ys).max()))
+
+
+def memory_need(methods: Sequence[str], rkpm: dict[str, Sequence], fem: dict[str, Sequence],
+                particles: Callable[[float], float], verb: str = "lower") -> _preflight.Need:
+    """The Need of a dynamic fracture case: its largest model among the study lists of the methods run.
+
+    Args:
+        methods: The methods to run.
+        rkpm, fem: The study lists of each method by parameter name, e.g. ``{"nodes": [150, 250]}``.
+        particles: Particles (or FEM vertices) of a model given one list entry.
+        verb: How the entry must change to shrink the model (``lower`` a count, ``raise`` a spacing).
+    """
+    lists = {**(rkpm if "rkpm" in methods else {}), **(fem if "fem" in methods else {})}
+    sizes = {name: max((particles(v) for v in vs), default=0.0) for name, vs in lists.items()}
+    name = max(sizes, key=sizes.get, default=None)
+    if name is None:
+        return _preflight.need(0.0, 0, "", "")
+    return _preflight.need(_preflight.DAMAGE_BYTES_PER_NODE, sizes[name],
+                           f"{name}={','.join(map(str, lists[name]))}", f"{verb} {name}")
 
 
 def plate(xs: np.ndarray, ys: np.ndarray, slits: Sequence, tips: Sequence[tuple[bool, bool]],

@@ -62,10 +62,11 @@ import numpy as np
 from rkfx.fracture import damage as dm
 from rkfx.assembly.boundary import boundary_quadrature, traction_load
 from rkfx.conditions import Traction
-from rkfx.fracture.tracking import tracking
+from rkfx.fracture.tracking import check_tracking, tracking
+from rkfx.assembly.smeared_strain import check_eps_p
 from rkfx.errors import InputError
 from rkfx.models.damage_dynamics import DamageRun
-from rkfx.cases import _cli
+from rkfx.cases import _cli, _preflight
 from rkfx.cases import _dynamic_fracture as dyn
 from rkfx.cases._cli import Param, Results, Run
 
@@ -82,15 +83,16 @@ PARAMS = {
     "sigma": Param(1.0e6, "traction on the top and bottom edges, a step at t = 0 [Pa]"),
     "plane": Param("strain", "2-D idealization: strain or stress"),
     "t_end": Param(80e-6, "end time [s]"),
-    "tol": Param(0.5, "particle tracking tolerance of (4.22)"),
+    "tol": Param(0.5, "particle tracking tolerance of (4.22), in (0, 1]"),
     "h": Param([8e-4, 4e-4, 2e-4], "nominal nodal spacings of the regularized models [m]"),
     "unregularized_h": Param([8e-4, 4e-4, 2e-4], "nominal nodal spacings of the constant-kappa_c models [m]"),
-    "fem_h": Param([8e-4, 4e-4, 2e-4], "element sizes of the crack-band finite element baseline [m]", fingerprint=False),
+    "fem_h": Param([8e-4, 4e-4, 2e-4], "element sizes of the crack-band finite element baseline [m]",
+                   fingerprint=False),
     "support_factor": Param(1.75, "RK support radius / nodal spacing (>= 1.6: see rkfx.cases.kalthoff)"),
-    "courant": Param(0.5, "dt = courant * h / c_d"),
-    "radius": Param(3.5, "tracking neighbourhood radius / nodal spacing"),
+    "courant": Param(0.5, "dt = courant * h / c_d, in (0, 1]"),
+    "radius": Param(3.5, "tracking neighbourhood radius / nodal spacing, >= 1"),
     "forward": Param(True, "tracking: candidates only ahead of their particle (false: (4.22) both ways)"),
-    "eps_p": Param(1.0, "weight of the MSCNI stabilization (0: plain SCNI)"),
+    "eps_p": Param(1.0, "weight of the MSCNI stabilization, >= 0 (0: plain SCNI)"),
 }
 QUICK = {"h": [1.6e-3, 8e-4], "unregularized_h": [1.6e-3, 8e-4], "fem_h": [1.6e-3, 8e-4]}
 
@@ -108,17 +110,17 @@ def grid(h: float) -> tuple[np.ndarray, np.ndarray]:
     return np.linspace(0.0, LX, _even(LX, h)), np.linspace(0.0, LY, _even(LY, h))
 
 
-def _check(E, nu, rho, ft, GF, sigma, plane, t_end, tol, hs, support_factor, courant, radius):
+def _check(E, nu, rho, ft, GF, sigma, plane, t_end, tol, hs, support_factor, courant, radius, eps_p=1.0):
     for name, v in (("rho", rho), ("sigma", sigma), ("t_end", t_end)):
         if not (np.isfinite(v) and v > 0):
             raise InputError(f"{name} = {v!r} must be positive")
     material = dm.DamageMaterial(E, nu, ft, GF, plane)
-    if not (0.0 < tol <= 1.0):
-        raise InputError(f"tol = {tol!r} must lie in (0, 1] (the seed uses 0.5)")
+    check_tracking(tol, radius)
     if not support_factor >= 1.6:
         raise InputError(f"support_factor = {support_factor!r}: use >= 1.6 (the crack mouth at x = 0 needs it)")
     if not 0 < courant <= 1.0:
         raise InputError(f"courant = {courant!r} must lie in (0, 1]")
+    check_eps_p(eps_p)
     for h in hs:
         if not (np.isfinite(h) and 0 < h <= LY / 20):
             raise InputError(f"h = {h!r} m: use 0 < h <= {LY / 20:g} m (at least 20 spacings across the plate)")
@@ -130,6 +132,19 @@ def _check(E, nu, rho, ft, GF, sigma, plane, t_end, tol, hs, support_factor, cou
             raise InputError(f"h = {h0:g} m is too coarse for G_F: kappa_c = G_F / (f_t h) <= kappa0; use "
                              f"h < E G_F / f_t^2 = {E * GF / ft**2:.3g} m")
     return material
+
+
+def check(*, E, nu, rho, ft, GF, sigma, plane, t_end, tol, h, unregularized_h, fem_h, support_factor, courant,
+          radius, eps_p, **_) -> None:
+    """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
+    every = [float(v) for v in [*h, *unregularized_h, *fem_h]]
+    _check(E, nu, rho, ft, GF, sigma, plane, t_end, tol, every, support_factor, courant, radius, eps_p)
+
+
+def memory_need(methods, *, h, unregularized_h, fem_h, **_) -> _preflight.Need:
+    """Peak memory of the finest model, (LX / h) (LY / h) particles (see ``rkfx.cases._preflight``)."""
+    return dyn.memory_need(methods, {"h": h, "unregularized_h": unregularized_h}, {"fem_h": fem_h},
+                           lambda v: (LX / v + 1) * (LY / v + 1) if v > 0 else 0.0, "raise")
 
 
 def traction_force(pl: dyn.Plate, sigma: float) -> np.ndarray:
@@ -239,7 +254,7 @@ def run(*, methods: Sequence[str] = ("rkpm",), E=3.2e10, nu=0.2, rho=2450.0, ft=
     and the crack-band finite elements at each element size."""
     hs, unreg, fems = [float(v) for v in h], [float(v) for v in unregularized_h], [float(v) for v in fem_h]
     material = _check(E, nu, rho, ft, GF, sigma, plane, t_end, tol, hs + unreg + fems, support_factor, courant,
-                      radius)
+                      radius, eps_p)
     prm = dict(E=E, nu=nu, rho=rho, ft=ft, GF=GF, sigma=sigma, plane=plane, t_end=t_end, tol=tol, h=hs,
                unregularized_h=unreg, fem_h=fems, support_factor=support_factor, courant=courant, radius=radius,
                forward=forward, eps_p=eps_p)

@@ -116,11 +116,17 @@ from rkfx.models.damage_bar import (
 from rkfx.errors import InputError, SolverError
 from rkfx.solvers.newton import NewtonOptions
 from rkfx.solvers.quasi_static import QuasiStatic, march
-from rkfx.cases import _cli
+from rkfx.cases import _cli, _preflight
 from rkfx.cases._cli import Param, Results, Run
 
 NAME = "cracked_bar"
 MEDIAN_DUAL_END = 1.6  # median-dual models are followed to 1.6 w_c: they break near 1.47 w_c
+
+# Memory of a load path (peak RSS, /usr/bin/time -v, cracked_bar --quick --method rkpm, steps=8): 0.30 GB
+# at nodes=256, 0.57 GB at 2048 and 0.93 GB at 4096, about 85 kB per node (two rows of n). The share
+# per load step (recorded profiles) was not separated: 1 kB per node and step is a generous guess.
+BAR_BYTES_PER_NODE = 100e3
+BAR_BYTES_PER_NODE_STEP = 1e3
 
 PARAMS = {
     "E": Param(2.0e6, "Young's modulus"),
@@ -128,7 +134,8 @@ PARAMS = {
     "ft": Param(200.0, "tensile strength f_t (kappa0 = ft / E)"),
     "L": Param(100.0, "bar length"),
     "A": Param(10.0, "cross-section area"),
-    "nodes": Param([16, 32, 64, 128], "nodes along the bar axis (even: x = L/2 between two node columns)", fingerprint=False),
+    "nodes": Param([16, 32, 64, 128], "nodes along the bar axis (even: x = L/2 between two node columns)",
+                   fingerprint=False),
     "weak_factor": Param(0.999, "kappa0 multiplier of the particles at x = L/2"),
     "steps": Param(100, "load steps from the elastic limit to u_end"),
     "u_end": Param(1.02, "last tip displacement / w_c"),
@@ -240,6 +247,21 @@ def _check(E, GF, ft, L, A, nodes, weak_factor, steps, u_end, stress_at, support
         if c not in CELLS:
             raise InputError(f"unknown cells {c!r}; choose from {', '.join(CELLS)}")
     CohesiveBar(L, A, E, GF, ft)  # w_c must exceed the elastic elongation f_t L / E
+
+
+def check(*, E, GF, ft, L, A, nodes, weak_factor, steps, u_end, stress_at, support_factor, cells, **_) -> None:
+    """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
+    _check(E, GF, ft, L, A, [int(n) for n in nodes], weak_factor, steps, u_end, stress_at, support_factor,
+           list(cells))
+    dm.DamageMaterial(E, 0.0, ft, GF, "stress")
+
+
+def memory_need(methods, *, nodes, steps, **_) -> _preflight.Need:
+    """Peak memory of the largest load path: two rows of max(nodes) nodes, ``steps`` load steps
+    (see ``rkfx.cases._preflight``)."""
+    n = max(nodes, default=0)
+    return _preflight.need(BAR_BYTES_PER_NODE + BAR_BYTES_PER_NODE_STEP * steps, 2 * n,
+                           f"nodes={','.join(map(str, nodes))}, steps={steps}", "lower nodes or steps")
 
 
 def _targets(u_peak: float, wc: float, steps: int, u_end: float, weak_factor: float = 0.999) -> np.ndarray:

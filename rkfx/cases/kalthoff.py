@@ -61,11 +61,11 @@ import numpy as np
 
 from rkfx.fracture import damage as dm
 from rkfx.conditions import Displacement, Velocity
-from rkfx.fracture.tracking import tracking
+from rkfx.fracture.tracking import check_tracking, tracking
 from rkfx.errors import InputError
-from rkfx.assembly.smeared_strain import constraint
+from rkfx.assembly.smeared_strain import check_eps_p, constraint
 from rkfx.models.damage_dynamics import DamageRun
-from rkfx.cases import _cli
+from rkfx.cases import _cli, _preflight
 from rkfx.cases import _dynamic_fracture as dyn
 from rkfx.cases._cli import Param, Results, Run
 
@@ -81,16 +81,16 @@ PARAMS = {
     "GF": Param(2.0e4, "fracture energy G_F [N/m]"),
     "v0": Param(16.5, "impact velocity [m/s]"),
     "t_end": Param(80e-6, "end time [s]"),
-    "tol": Param(0.3, "particle tracking tolerance of (4.22)"),
+    "tol": Param(0.3, "particle tracking tolerance of (4.22), in (0, 1]"),
     "nodes": Param([150, 250, 350, 450], "particles per side of the regularized models"),
     "unregularized_nodes": Param([150, 250, 350], "particles per side of the constant-kappa_c models"),
     "no_tracking_nodes": Param([150, 250], "particles per side of the models without tracking", fingerprint=False),
     "fem_nodes": Param([150, 250], "crack-band FEM: element size 0.1 / (n - 1)", fingerprint=False),
     "support_factor": Param(1.75, "RK support radius / nodal spacing (>= 1.6: see the module docstring)"),
-    "courant": Param(0.5, "dt = courant * h / c_d"),
-    "radius": Param(3.5, "tracking neighbourhood radius / nodal spacing"),
+    "courant": Param(0.5, "dt = courant * h / c_d, in (0, 1]"),
+    "radius": Param(3.5, "tracking neighbourhood radius / nodal spacing, >= 1"),
     "forward": Param(True, "tracking: candidates only ahead of their particle (false: (4.22) both ways)"),
-    "eps_p": Param(1.0, "weight of the MSCNI stabilization (0: plain SCNI)"),
+    "eps_p": Param(1.0, "weight of the MSCNI stabilization, >= 0 (0: plain SCNI)"),
     "angle_radius": Param(0.1, "crack-angle fit: cracked particles within this distance of the tip [m]",
                           fingerprint=False),
 }
@@ -105,7 +105,7 @@ def grid(n: int) -> tuple[np.ndarray, np.ndarray]:
     return np.linspace(0.0, SIDE, nx), np.linspace(0.0, SIDE, ny)
 
 
-def _check(E, nu, rho, ft, GF, v0, t_end, tol, nodes, support_factor, courant, radius, angle_radius):
+def _check(E, nu, rho, ft, GF, v0, t_end, tol, nodes, support_factor, courant, radius, angle_radius, eps_p=1.0):
     for name, v in (("rho", rho), ("v0", v0), ("t_end", t_end), ("angle_radius", angle_radius)):
         if not (np.isfinite(v) and v > 0):
             raise InputError(f"{name} = {v!r} must be positive")
@@ -114,9 +114,8 @@ def _check(E, nu, rho, ft, GF, v0, t_end, tol, nodes, support_factor, courant, r
                          "beside it and a smaller support leaves them too few (see the module docstring)")
     if not 0.0 < courant <= 1.0:
         raise InputError(f"courant = {courant!r}: use 0 < courant <= 1 (dt = courant h / c_d; stability)")
-    for name, v in (("radius", radius), ("tol", tol)):
-        if not (np.isfinite(v) and v > 0):
-            raise InputError(f"{name} = {v!r} must be positive")
+    check_tracking(tol, radius)
+    check_eps_p(eps_p)
     for n in nodes:
         if n < 20:
             raise InputError(f"nodes = {n}: use at least 20 particles per side (the crack needs cells around it)")
@@ -126,6 +125,20 @@ def _check(E, nu, rho, ft, GF, v0, t_end, tol, nodes, support_factor, courant, r
         raise InputError(f"nodes = {min(nodes)} is too coarse for G_F: kappa_c = G_F / (f_t h) <= kappa0; use "
                          f"h < E G_F / f_t^2 = {E * GF / ft**2:.3g} m")
     return material
+
+
+def check(*, E, nu, rho, ft, GF, v0, t_end, tol, nodes, unregularized_nodes, no_tracking_nodes, fem_nodes,
+          support_factor, courant, radius, angle_radius, eps_p, **_) -> None:
+    """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
+    every = [int(n) for n in [*nodes, *unregularized_nodes, *no_tracking_nodes, *fem_nodes]]
+    _check(E, nu, rho, ft, GF, v0, t_end, tol, every, support_factor, courant, radius, angle_radius, eps_p)
+
+
+def memory_need(methods, *, nodes, unregularized_nodes, no_tracking_nodes, fem_nodes, **_) -> _preflight.Need:
+    """Peak memory of the largest model, about n^2 particles (see ``rkfx.cases._preflight``)."""
+    return dyn.memory_need(methods, {"nodes": nodes, "unregularized_nodes": unregularized_nodes,
+                                     "no_tracking_nodes": no_tracking_nodes}, {"fem_nodes": fem_nodes},
+                           lambda n: (n + 1) ** 2)
 
 
 def model_conditions(pl: dyn.Plate, v0: float):
@@ -202,7 +215,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.9e11, nu=0.3, rho=8000.
     nodes, unreg, free, fem = ([int(n) for n in v] for v in (nodes, unregularized_nodes, no_tracking_nodes,
                                                               fem_nodes))
     material = _check(E, nu, rho, ft, GF, v0, t_end, tol, nodes + unreg + free + fem, support_factor, courant,
-                      radius, angle_radius)
+                      radius, angle_radius, eps_p)
     prm = {"E": E, "nu": nu, "rho": rho, "ft": ft, "GF": GF, "v0": v0, "t_end": t_end, "tol": tol, "nodes": nodes,
            "unregularized_nodes": unreg, "no_tracking_nodes": free, "fem_nodes": fem,
            "support_factor": support_factor, "courant": courant, "radius": radius, "forward": forward, "eps_p": eps_p,

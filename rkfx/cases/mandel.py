@@ -55,7 +55,7 @@ from rkfx.errors import InputError
 from rkfx.geometry.particles import structured
 from rkfx.models.poroelasticity import VARIANTS, PoroMaterial, solve_biot
 from rkfx.solvers.integrate import time_grid
-from rkfx.cases import _cli
+from rkfx.cases import _cli, _preflight
 from rkfx.cases._cli import Param, Results, Run
 
 NAME = "mandel"
@@ -81,13 +81,13 @@ PARAMS = {
     "variants": Param(["scni+fpp", "ni"], "RKPM variants of the profiles study", fingerprint=False),
     "early_variants": Param(list(VARIANTS), "RKPM variants of the early-time study", fingerprint=False),
     "fem": Param(list(FEM_ELEMENTS), "FEM elements: taylor-hood, q1q1, q1q1-fpp", fingerprint=False),
-    "support_factor": Param(1.5, "RK support radius / nodal spacing [-]"),
+    "support_factor": Param(1.5, "RK support radius / nodal spacing [-], > 1"),
 }
 QUICK = {"nx": 41, "ny": 5, "t_D": [0.01, 0.1], "early_variants": ["ni", "scni+fpp"],
          "fem": ["taylor-hood", "q1q1-fpp"]}
 
 
-def _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F):
+def _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F, support_factor=1.5):
     for name, v in (("nx", nx), ("ny", ny)):
         if v < 3:
             raise InputError(f"{name} = {v}: need at least 3 nodes per direction")
@@ -106,6 +106,26 @@ def _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F):
             raise InputError(f"unknown FEM element {e!r}; choose from {', '.join(FEM_ELEMENTS)}")
     if F == 0:
         raise InputError("F = 0: the problem has no load")
+    _preflight.support_factor_ok(support_factor)
+
+
+def check(*, E, nu, k, alpha, S, Lx, Ly, F, nx, ny, dt_D, growth, t_D, variants, early_variants, fem,
+          support_factor, **_) -> None:
+    """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
+    _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F, support_factor)
+    PoroMaterial(E, nu, k, alpha, S)
+    exact = Mandel(E, nu, k, Lx, Ly, F, alpha, S)
+    first = dt_D * (Lx / (nx - 1)) ** 2 / exact.c  # the first step is the earliest time evaluated
+    try:
+        exact.n_roots(np.array([first, min(t_D) * Lx**2 / exact.c]))
+    except ValueError as err:  # the exact series cannot reach so early a time
+        raise InputError(f"dt_D = {dt_D!r}, nx = {nx}: the first step is too short for the exact solution ({err}); "
+                         "raise dt_D or t_D, or lower nx") from None
+
+
+def memory_need(methods, *, nx, ny, **_) -> _preflight.Need:
+    """Peak memory of the largest run, nx ny nodes (see ``rkfx.cases._preflight``)."""
+    return _preflight.poro_need(methods, nx * ny, f"nx={nx}, ny={ny}", "lower nx or ny")
 
 
 def _conditions(exact):
@@ -139,7 +159,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, 
         variants=("scni+fpp", "ni"), early_variants=VARIANTS, fem=FEM_ELEMENTS, support_factor=1.5,
         checkpoint_every=0, work_dir=None, resume=None) -> Results:
     """Both studies for every requested method; see the module docstring."""
-    _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F)
+    _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F, support_factor)
     material = PoroMaterial(E, nu, k, alpha, S)
     exact = Mandel(E, nu, k, Lx, Ly, F, alpha, S)
     c, p0 = exact.c, exact.p0

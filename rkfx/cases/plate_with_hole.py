@@ -49,12 +49,13 @@ from rkfx.models.elastostatics import solve_plane_strain
 from rkfx.errors import InputError
 from rkfx.integration.norms import relative_errors
 from rkfx.integration.quadrature import RULES
-from rkfx.cases import _cli
+from rkfx.cases import _cli, _preflight
 from rkfx.cases._cli import Param, Results, Run
 
 NAME = "plate_with_hole"
 HOLE_REFINEMENT = 3.0  # mesh size on the hole = h / HOLE_REFINEMENT
 NUM_PROFILE = 300      # points of the sigma_xx profile along x = 0
+PLATE_NODES_PER_AREA = 2.5  # gmsh vertices per h^2 of the quarter plate (measured 2.4-2.6, finer on the hole)
 
 PARAMS = {
     "E": Param(1.0e3, "Young's modulus [Pa]"),
@@ -63,11 +64,11 @@ PARAMS = {
     "a": Param(1.0, "hole radius [m]"),
     "L": Param(5.0, "side of the quarter plate [0, L]^2 [m]"),
     "h": Param(0.5, "mesh size at the outer corners on the coarsest level (h/3 on the hole) [m]"),
-    "levels": Param(4, "number of meshes, h halved each time"),
+    "levels": Param(4, "number of meshes, h halved each time, >= 1"),
     "rules": Param(["mscni"], "RKPM domain integration rules: mscni, scni, dni, gauss1, gauss2, gauss4"),
-    "support_factor": Param(1.5, "RK support radius / nodal spacing [-]"),
+    "support_factor": Param(1.5, "RK support radius / nodal spacing [-], > 1"),
     "bc_method": Param("nitsche", "RKPM essential conditions: nitsche or transformation"),
-    "fem_degrees": Param([1, 2], "FEM Lagrange degrees"),
+    "fem_degrees": Param([1, 2], "FEM Lagrange degrees: 1, 2 or 3"),
 }
 QUICK = {"h": 0.5, "levels": 1}
 
@@ -92,6 +93,22 @@ def _validate(a, L, h, levels, T, rules, bc_method, fem_degrees):
     for d in fem_degrees:
         if d not in (1, 2, 3):
             raise InputError(f"fem_degrees: degree {d!r} not offered; use 1, 2 or 3")
+
+
+def check(*, E, nu, T, a, L, h, levels, rules, support_factor, bc_method, fem_degrees, **_) -> None:
+    """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
+    ElasticMaterial(E, nu)
+    _validate(a, L, h, levels, T, list(rules), bc_method, [int(d) for d in fem_degrees])
+    _preflight.support_factor_ok(support_factor)
+
+
+def memory_need(methods, *, a, L, h, levels, fem_degrees, **_) -> _preflight.Need:
+    """Peak memory of the finest level (see ``rkfx.cases._preflight``)."""
+    finest = h / 2.0 ** (min(levels, 200) - 1)
+    nodes = PLATE_NODES_PER_AREA * (L**2 - np.pi * a**2 / 4) / finest**2
+    per = max([_preflight.ELASTIC_RKPM_BYTES_PER_NODE if "rkpm" in methods else 0.0,
+               _preflight.ELASTIC_FEM_BYTES_PER_NODE * max(fem_degrees, default=1) ** 2 if "fem" in methods else 0.0])
+    return _preflight.need(per, nodes, f"h={h:g}, levels={levels}", "raise h or lower levels")
 
 
 def mesh_plate(a: float, L: float, h: float):

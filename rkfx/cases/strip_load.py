@@ -52,7 +52,7 @@ from rkfx.errors import InputError
 from rkfx.geometry.particles import graded
 from rkfx.models.poroelasticity import VARIANTS, PoroMaterial, solve_biot
 from rkfx.solvers.integrate import time_grid
-from rkfx.cases import _cli
+from rkfx.cases import _cli, _preflight
 from rkfx.cases._cli import Param, Results, Run
 
 NAME = "strip_load"
@@ -72,31 +72,40 @@ PARAMS = {
     "dt_D": Param(0.025, "time step in T_D = E k t / ((1 + nu) b^2) [-]"),
     "t_D_profile": Param(0.1, "time of the pressure profile along the axis [-]"),
     "t_D_end": Param(2.0, "end of the pressure history [-]"),
-    "depth_history": Param(0.2, "depth of the history point on the axis [m]"),
+    "depth_history": Param(0.2, "depth of the history point on the axis [m], in [0, extent b]"),
     "steps_low": Param(4, "time steps of the low-permeability study"),
     "variants": Param(["scni+fpp", "ni"], "RKPM variants of the drained study", fingerprint=False),
     "low_variants": Param(["ni", "scni+fpp"], "RKPM variants of the low-permeability study", fingerprint=False),
     "fem": Param(["taylor-hood", "q1q1-fpp"], "FEM elements: taylor-hood, q1q1, q1q1-fpp", fingerprint=False),
-    "support_factor": Param(1.5, "RK support radius / nodal spacing [-]"),
+    "support_factor": Param(1.5, "RK support radius / nodal spacing [-], > 1"),
 }
 QUICK = {"nx": 21, "ny": 21, "t_D_end": 0.5, "fem": ["taylor-hood"]}
 
 
-def node_lines(b: float, length: float, n: int, first: float, uniform_to: float = 0.0) -> np.ndarray:
-    """n coordinates on [0, length]: uniform (spacing ``first``) up to ``uniform_to``, then geometric."""
+def _node_line_sizes(b: float, length: float, n: int, first: float, uniform_to: float = 0.0,
+                     name: str = "nx") -> tuple[int, int, float]:
+    """Uniform intervals, graded intervals and graded span of ``node_lines``; InputError if ``n`` does not fit."""
     m = int(round(uniform_to / first)) if uniform_to > 0 else 0
     rest = n - 1 - m
     if rest < 1:
-        raise InputError(f"{n} nodes cannot resolve the strip: need more than {m + 1}")
+        raise InputError(f"{name} = {n}: {n} nodes cannot resolve the strip: need more than {m + 1}")
     span = length - m * first
     if rest * first >= span:
-        raise InputError(f"{n} nodes over {length:g} m are too many for a first spacing of {first:g} m")
+        raise InputError(f"{name} = {n}: {n} nodes over {length:g} m are too many for a first spacing of "
+                         f"{first:g} m (b / {STRIP_INTERVALS}); use fewer than {int(span / first) + m + 1}")
+    return m, rest, span
+
+
+def node_lines(b: float, length: float, n: int, first: float, uniform_to: float = 0.0) -> np.ndarray:
+    """n coordinates on [0, length]: uniform (spacing ``first``) up to ``uniform_to``, then geometric."""
+    m, rest, span = _node_line_sizes(b, length, n, first, uniform_to)
     ratio = brentq(lambda r: first * (r**rest - 1) / (r - 1) - span, 1.0 + 1e-9, 10.0)
     steps = first * ratio ** np.arange(rest)
     return np.r_[first * np.arange(m + 1), m * first + np.cumsum(steps)]
 
 
-def _check(nx, ny, dt_D, t_D_profile, t_D_end, extent, b, q, steps_low, variants, low_variants, fem):
+def _check(nx, ny, dt_D, t_D_profile, t_D_end, extent, b, q, steps_low, variants, low_variants, fem,
+           support_factor=1.5, depth_history=0.0):
     for name, v in (("b", b), ("extent", extent), ("dt_D", dt_D), ("t_D_profile", t_D_profile)):
         if not v > 0:
             raise InputError(f"{name} = {v!r} must be positive")
@@ -116,6 +125,30 @@ def _check(nx, ny, dt_D, t_D_profile, t_D_end, extent, b, q, steps_low, variants
             raise InputError(f"unknown FEM element {e!r}; choose from {', '.join(FEM_ELEMENTS)}")
     if nx < STRIP_INTERVALS + 3 or ny < 4:
         raise InputError(f"nx = {nx}, ny = {ny}: need nx >= {STRIP_INTERVALS + 3} and ny >= 4")
+    _preflight.support_factor_ok(support_factor)
+    first = b / STRIP_INTERVALS
+    _node_line_sizes(b, extent * b, nx, first, uniform_to=b, name="nx")
+    _node_line_sizes(b, extent * b, ny, first, name="ny")
+    if not 0 <= depth_history <= extent * b:
+        raise InputError(f"depth_history = {depth_history!r} m: use a depth in [0, extent b] = "
+                         f"[0, {extent * b:g}] m")
+
+
+def check(*, E, nu, k, k_low, q, b, extent, nx, ny, dt_D, t_D_profile, t_D_end, depth_history, steps_low,
+          variants, low_variants, fem, support_factor, **_) -> None:
+    """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
+    _check(nx, ny, dt_D, t_D_profile, t_D_end, extent, b, q, steps_low, variants, low_variants, fem,
+           support_factor, depth_history)
+    PoroMaterial(E, nu, k)
+    try:
+        PoroMaterial(E, nu, k_low)
+    except InputError:
+        raise InputError(f"k_low = {k_low!r} must be positive [m^2/(Pa s)]") from None
+
+
+def memory_need(methods, *, nx, ny, **_) -> _preflight.Need:
+    """Peak memory of the largest run, nx ny nodes (see ``rkfx.cases._preflight``)."""
+    return _preflight.poro_need(methods, nx * ny, f"nx={nx}, ny={ny}", "lower nx or ny")
 
 
 def _solve(method, xs, ys, material, q, b, times, outputs, samples, drained, support_factor, io):
@@ -152,7 +185,8 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.0, k=5.0e-8 /
         support_factor=1.5, checkpoint_every=0, work_dir=None, resume=None) -> Results:
     """Both studies for every requested method; see the module docstring."""
     ck = _cli.Checkpoints(checkpoint_every, work_dir, resume)
-    _check(nx, ny, dt_D, t_D_profile, t_D_end, extent, b, q, steps_low, variants, low_variants, fem)
+    _check(nx, ny, dt_D, t_D_profile, t_D_end, extent, b, q, steps_low, variants, low_variants, fem,
+           support_factor, depth_history)
     length = extent * b
     first = b / STRIP_INTERVALS
     xs = node_lines(b, length, nx, first, uniform_to=b)

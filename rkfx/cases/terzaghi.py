@@ -52,7 +52,7 @@ from rkfx.errors import InputError
 from rkfx.geometry.particles import structured
 from rkfx.models.poroelasticity import VARIANTS, PoroMaterial, solve_biot
 from rkfx.solvers.integrate import time_grid
-from rkfx.cases import _cli
+from rkfx.cases import _cli, _preflight
 from rkfx.cases._cli import Param, Results, Run
 
 NAME = "terzaghi"
@@ -78,12 +78,23 @@ PARAMS = {
     "variants": Param(list(VARIANTS), "RKPM variants", fingerprint=False),
     "fem": Param(list(FEM_ELEMENTS), "FEM elements: taylor-hood, q1q1, q1q1-fpp", fingerprint=False),
     "refine_ny": Param([21, 41, 81], "nodes along the height of the refinement study", fingerprint=False),
-    "support_factor": Param(1.5, "RK support radius / nodal spacing [-]"),
+    "support_factor": Param(1.5, "RK support radius / nodal spacing [-], > 1"),
 }
 QUICK = {"refine_ny": [21, 41], "fem": ["taylor-hood", "q1q1-fpp"]}
 
 
-def _check(W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny):
+def _times(t_out) -> list[float]:
+    """``t_out`` as numbers (an empty default list reads --set values as text)."""
+    try:
+        times = [float(t) for t in t_out]
+    except (TypeError, ValueError):
+        raise InputError(f"t_out = {list(t_out)!r}: give output times in seconds, e.g. t_out=10,100") from None
+    if not all(np.isfinite(times)):
+        raise InputError(f"t_out = {times!r}: output times must be finite")
+    return times
+
+
+def _check(W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny, support_factor=1.5):
     for name, v in (("W", W), ("H", H), ("dt", dt)):
         if not v > 0:
             raise InputError(f"{name} = {v!r} must be positive")
@@ -104,6 +115,26 @@ def _check(W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny):
     for e in fem:
         if e not in FEM_ELEMENTS:
             raise InputError(f"unknown FEM element {e!r}; choose from {', '.join(FEM_ELEMENTS)}")
+    _preflight.support_factor_ok(support_factor)
+
+
+def check(*, E, nu, k, alpha, S, W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny,
+          support_factor, **_) -> None:
+    """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
+    _check(W, H, q, nx, ny, dt, t_end, _times(t_out), growth, variants, fem, refine_ny, support_factor)
+    PoroMaterial(E, nu, k, alpha, S)
+
+
+def _refined_nx(nx, ny, n):
+    """Nodes across the width of the refinement model with ``n`` nodes along the height."""
+    return max(3, int(round((nx - 1) * (n - 1) / (ny - 1))) + 1)
+
+
+def memory_need(methods, *, nx, ny, refine_ny, **_) -> _preflight.Need:
+    """Peak memory of the largest run: nx ny nodes, or a refinement model (see ``rkfx.cases._preflight``)."""
+    nodes = max([nx * ny] + [_refined_nx(nx, ny, n) * n for n in refine_ny])
+    return _preflight.poro_need(methods, nodes, f"nx={nx}, ny={ny}, refine_ny={','.join(map(str, refine_ny))}",
+                                "lower nx, ny or refine_ny")
 
 
 def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_factor, io):
@@ -135,7 +166,8 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e3, nu=0.0, k=1.0e-9, 
         q=1.0e3, nx=7, ny=21, dt=1.0, t_end=1.0, t_out=(), growth=1.5, variants=VARIANTS, fem=FEM_ELEMENTS,
         refine_ny=(21, 41, 81), support_factor=1.5, checkpoint_every=0, work_dir=None, resume=None) -> Results:
     """Both studies for every requested method; see the module docstring."""
-    _check(W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny)
+    t_out = _times(t_out)
+    _check(W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny, support_factor)
     material = PoroMaterial(E, nu, k, alpha, S)
     ck = _cli.Checkpoints(checkpoint_every, work_dir, resume)
     exact = Terzaghi(E, nu, k, H, q, alpha, S)
@@ -170,7 +202,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e3, nu=0.0, k=1.0e-9, 
     refine = [m for m in ("rkpm-scni+fpp", "fem-taylor-hood") if m.split("-")[0] in methods]
     for label in refine:
         for n in refine_ny:
-            mx = max(3, int(round((nx - 1) * (n - 1) / (ny - 1))) + 1)
+            mx = _refined_nx(nx, ny, n)
             p_h, wall, dofs = _solve(label, W, H, mx, n, material, q, np.array([0.0, dt]), [dt], samples,
                                      support_factor, ck.for_run(f"{label}-ny{n}"))
             results.runs.append(Run(f"{label} ny={n}", wall, dofs,

@@ -86,6 +86,14 @@ class Tracking:
         return cand, nodes[rows[ok][first]]
 
 
+def check_tracking(tol: float, radius: float) -> None:
+    """Raise InputError unless the tolerance of (4.22) lies in (0, 1] and the radius is >= 1 spacing."""
+    if not (0.0 < tol <= 1.0):
+        raise InputError(f"tracking tolerance tol = {tol!r} must lie in (0, 1]; the seed uses 0.3-0.5")
+    if not radius >= 1.0:
+        raise InputError(f"tracking radius = {radius!r} spacings must be >= 1 (2.5 reaches the (1, 2) neighbours)")
+
+
 def tracking(x: np.ndarray, spacing: np.ndarray, tol: float, seeds: np.ndarray | None = None,
              radius: float = 3.5, enabled: bool = True, forward: bool = True) -> Tracking:
     """Neighbour sets N_L = particles within ``radius`` h_L of x_L, and the tracking settings.
@@ -99,10 +107,7 @@ def tracking(x: np.ndarray, spacing: np.ndarray, tol: float, seeds: np.ndarray |
         enabled: ``False`` switches tracking off.
         forward: Candidates only ahead of their particle (``False``: (4.22) both ways).
     """
-    if not (0.0 < tol <= 1.0):
-        raise InputError(f"tracking tolerance tol = {tol!r} must lie in (0, 1]; the seed uses 0.3-0.5")
-    if not radius >= 1.0:
-        raise InputError(f"tracking radius = {radius!r} spacings must be >= 1 (2.5 reaches the (1, 2) neighbours)")
+    check_tracking(tol, radius)
     x = np.ascontiguousarray(x, float)
     n = len(x)
     mask = np.zeros(n, bool)
