@@ -109,16 +109,19 @@ def _bytes(name: str, data: bytes) -> Callable[[Path], None]:
     return lambda tmp: (tmp / name).write_bytes(data)
 
 
-def _stored_run(case: str, run: str) -> Callable[[Path], None]:
-    """An interrupted invocation of ``case`` with its default parameters in ``old-run``: the
-    fingerprint and one run's folder."""
+def _stored_run(case: str, run: str, quick: bool = False, checkpoint: bytes | None = None) -> Callable[[Path], None]:
+    """An interrupted invocation of ``case`` in ``old-run`` with its default (or ``quick``)
+    parameters: the fingerprint and one run's folder, holding ``checkpoint`` if given."""
     def make(tmp: Path) -> None:
         from rkfx.cases import _cli  # noqa: PLC0415
 
         module = importlib.import_module(f"rkfx.cases.{case}")
-        params = _cli.parse_params(module.PARAMS)
-        (tmp / "old-run" / "checkpoints" / run).mkdir(parents=True)
-        _cli.write_fingerprint(tmp / "old-run" / "checkpoints", _cli.fingerprint(case, module.PARAMS, params, "both"))
+        params = _cli.parse_params(module.PARAMS, base=module.QUICK if quick else None)
+        folder = tmp / "old-run" / "checkpoints" / run
+        folder.mkdir(parents=True)
+        if checkpoint is not None:
+            (folder / "checkpoint.npz").write_bytes(checkpoint)
+        _cli.write_fingerprint(folder.parent, _cli.fingerprint(case, module.PARAMS, params, "both"))
     return make
 
 
@@ -157,10 +160,10 @@ ROWS: list[Row] = [
     Row("--recompute without --resume", "kalthoff", ("--recompute",)),
     Row("--resume with other parameters", "kalthoff", ("--resume", "old-run", "--set", "v0=30"),
         setup=_stored_run("kalthoff", "rkpm-dpm_n150")),
-    Row("--resume of runs without a fingerprint", "mandel", ("--resume", "old-run"),
-        setup=_folder("old-run/checkpoints/rkpm-ni-profiles")),
+    Row("--resume of runs without a fingerprint", "strip_load", ("--resume", "old-run"),
+        setup=_folder("old-run/checkpoints/rkpm-ni")),
     Row("garbled checkpoint file", "mandel", ("--quick", "--method", "rkpm", "--resume", "old-run"),
-        setup=_file("old-run/checkpoints/rkpm-scni+fpp-profiles/checkpoint.npz", "garbage\n"), work=True),
+        setup=_stored_run("mandel", "rkpm-scni+fpp-profiles", quick=True, checkpoint=b"garbage\n"), work=True),
     # --- memory: refused before any work ---
     Row("too big for memory", "mandel", ("--set", "nx=1000000000")),
     Row("too big for memory", "kalthoff", ("--set", "nodes=150,1000000")),

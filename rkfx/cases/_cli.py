@@ -372,8 +372,14 @@ def check_resume(resume: Path, stamp: Mapping[str, Any], recompute: bool) -> boo
             diff = differences(json.loads(path.read_text()), stamp)
         except (ValueError, AttributeError):
             diff = [f"{path} is unreadable"]
+    elif stored_runs:
+        if recompute:
+            logging.getLogger("rkfx").info("resume: %s has no %s; computing every run again", folder, FINGERPRINT)
+            return False
+        raise ParameterError(f"--resume {resume}: {folder} has no {FINGERPRINT} (written by an older rkfx), so its "
+                             "runs cannot be checked against these parameters; add --recompute to compute them again")
     else:
-        diff = [f"{folder} has no {FINGERPRINT} (written by an older rkfx)"] if stored_runs else []
+        diff = []
     if not diff:
         return True
     if recompute:
@@ -384,8 +390,14 @@ def check_resume(resume: Path, stamp: Mapping[str, Any], recompute: bool) -> boo
 
 
 def write_fingerprint(folder: Path, stamp: Mapping[str, Any]) -> list[Path]:
-    """Write ``folder/fingerprint.json``; returns what was created here (for ``_unstamp``)."""
+    """Write ``folder/fingerprint.json`` unless it holds ``stamp`` already (up to the method);
+    returns what was created here (for ``_unstamp``)."""
     folder = Path(folder)
+    try:
+        if not differences(json.loads((folder / FINGERPRINT).read_text()), stamp):
+            return []
+    except (OSError, ValueError, AttributeError):
+        pass
     made = []
     missing = folder
     while not missing.exists():
