@@ -27,21 +27,17 @@ def main(argv=None):
     from rkfx.fracture import damage as dm
     from rkfx.cases import _dynamic_fracture as dyn
     from rkfx.cases import kalthoff as k
-    from rkfx.fracture.tracking import tracking
     from rkfx.models.damage_dynamics import DamageForce, damage_field
     from rkfx.warmup import warm_up
 
     warm_up()
     k.run(methods=("rkpm",), nodes=[40], unregularized_nodes=[], no_tracking_nodes=[], fem_nodes=[],
           t_end=5e-6)  # compile the step kernels
-    material = dm.DamageMaterial(1.9e11, 0.3, 9.5e8, 2e4, "strain")
+    prm = {name: spec.default for name, spec in k.PARAMS.items()}
+    material = dm.DamageMaterial(prm["E"], prm["nu"], prm["ft"], prm["GF"], "strain")
     t0 = time.perf_counter()
-    xs, ys = k.grid(args.nodes)
-    pl = dyn.plate(xs, ys, [((0.0, k.A2), (k.A1, k.A2))], [(False, True)], material, 8000.0, 1.75)
-    seeds = np.linalg.norm(pl.p.x - [k.A1, k.A2], axis=1) < 0.75 * pl.h
-    track = tracking(pl.p.x, pl.p.spacing, 0.3, seeds, 3.5)
-    model = dyn.damage_model(pl, material)
-    conditions = k.model_conditions(pl, 16.5)
+    pl, track, model = k.setup(args.nodes, material, prm)
+    conditions = k.model_conditions(pl, prm["v0"])
     setup = time.perf_counter() - t0
     run = dyn.simulate("bench", pl, model, track, conditions, args.t_end)
     n = pl.p.num_nodes
@@ -69,7 +65,7 @@ def main(argv=None):
     t_all = (time.perf_counter() - t) / reps
     per_step = run.wall_time_s / run.steps
     stab = pl.op.stabilization
-    print(f"particles {n:,} (grid {len(xs)} x {len(ys)}), subcells {len(stab.owner):,}, "
+    print(f"particles {n:,} (grid {len(pl.xs)} x {len(pl.ys)}), subcells {len(stab.owner):,}, "
           f"nnz(grad N over subcells) {stab.rows.indices.size:,}, h = {1e6 * pl.h:.1f} um, dt = {1e9 * pl.dt:.2f} ns")
     print(f"set-up {setup:.1f} s; {run.steps} steps in {run.wall_time_s:.1f} s = {1e3 * per_step:.1f} ms per step")
     print(f"one step: strains {1e3 * t_strain:.1f} ms, force {1e3 * t_force:.1f} ms, damage force in all "

@@ -79,7 +79,7 @@ def _force(indptr, indices, grad, stress, volume, out):
 
 
 @numba.njit(parallel=True, cache=True)
-def _cell_average(ptr, fraction, sub):
+def cell_average(ptr, fraction, sub):
     """Cell strains e_L = sum_C (A_C / A_L) e_C from the subcell strains of each particle,
     shape ``(n, 3)``; ``sub`` becomes the differences e_L - e_C in place."""
     n = len(ptr) - 1
@@ -104,7 +104,7 @@ def _cell_average(ptr, fraction, sub):
 
 
 @numba.njit(parallel=True, cache=True)
-def _subcell_load(ptr, fraction, weight, volume, stress, sub_stress, out):
+def subcell_load(ptr, fraction, weight, volume, stress, sub_stress, out):
     """tau_C = (A_C / A_L) (V_L Sigma_L + sum_C' w_C' s_C') - w_C s_C per subcell C of each
     particle L: the stresses whose transposed subcell product is the whole force
     (``sub_stress`` empty: no MSCNI terms)."""
@@ -136,7 +136,7 @@ def _linear_stress(e, c, out):
             out[i, j] = c[j, 0] * e[i, 0] + c[j, 1] * e[i, 1] + c[j, 2] * e[i, 2]
 
 
-def _transpose(rows: SparseRows) -> SparseRows:
+def transpose_rows(rows: SparseRows) -> SparseRows:
     """The entries of ``rows`` grouped by column (stable: each column's entries in row order)."""
     n = rows.num_rows
     row = np.repeat(np.arange(n, dtype=np.int32), np.diff(rows.indptr))
@@ -215,7 +215,7 @@ class SmearedStrain:
         interleaved coefficients d of shape ``(2 n,)`` [m]."""
         if self.stabilization is not None:
             return self.strains(d)[0]
-        return _apply(self.rows, d)
+        return row_strains(self.rows, d)
 
     def strains(self, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The smeared strains ``(n, 3)`` and the MSCNI differences (B~_L - B~_C) d per subcell
@@ -223,8 +223,8 @@ class SmearedStrain:
         s = self.stabilization
         if s is None:
             raise InputError("this operator has no MSCNI terms; build it with smeared_strain(..., eps_p=1)")
-        sub = _apply(s.rows, d)
-        return _cell_average(s.ptr, s.fraction, sub), sub
+        sub = row_strains(s.rows, d)
+        return cell_average(s.ptr, s.fraction, sub), sub
 
     def force(self, stress: np.ndarray, subcell_stress: np.ndarray | None = None) -> np.ndarray:
         """f_int = sum_L B~_L^T Sigma_L V_L (eq. 4.34) for nodal stresses ``(n, 3)`` [Pa], plus
@@ -235,12 +235,12 @@ class SmearedStrain:
         if s is None:
             if subcell_stress is not None:
                 raise InputError("subcell stresses given to an operator without MSCNI terms")
-            return _apply_t(self.rows_t, stress, self.volume)
+            return transposed_force(self.rows_t, stress, self.volume)
         sub = np.empty((0, 3)) if subcell_stress is None else \
             np.ascontiguousarray(subcell_stress, dtype=np.float64)
         load = np.empty((len(s.owner), 3))
-        _subcell_load(s.ptr, s.fraction, s.weight, self.volume, stress, sub, load)
-        return _apply_t(s.rows_t, load, s._unit)
+        subcell_load(s.ptr, s.fraction, s.weight, self.volume, stress, sub, load)
+        return transposed_force(s.rows_t, load, s._unit)
 
     @cached_property
     def B(self) -> sp.csr_matrix:
@@ -253,13 +253,16 @@ class SmearedStrain:
         return self.B.T.tocsr()
 
 
-def _apply(rows: SparseRows, d: np.ndarray) -> np.ndarray:
+def row_strains(rows: SparseRows, d: np.ndarray) -> np.ndarray:
+    """Voigt strains of every row of smoothed gradients for interleaved d, shape ``(num_rows, 3)``."""
     out = np.empty((rows.num_rows, 3))
     _strain(rows.indptr, rows.indices, rows.data, np.ascontiguousarray(d, dtype=np.float64), out)
     return out
 
 
-def _apply_t(rows_t: SparseRows, stress: np.ndarray, weight: np.ndarray) -> np.ndarray:
+def transposed_force(rows_t: SparseRows, stress: np.ndarray, weight: np.ndarray) -> np.ndarray:
+    """Interleaved force sum_rows grad^T stress weight per column of ``rows_t`` (transposed rows:
+    each node's entries in row order), shape ``(2 num_nodes,)``."""
     out = np.empty(2 * rows_t.num_rows)
     _force(rows_t.indptr, rows_t.indices, rows_t.data, np.ascontiguousarray(stress, dtype=np.float64), weight, out)
     return out
@@ -285,17 +288,17 @@ def smeared_strain(p: Particles, rk: RKApproximation, domains: NodalDomains | No
     volume = np.ascontiguousarray(domains.area, dtype=np.float64)
     if eps_p == 0:
         cell = smoothed_gradients(p, rk, domains, subcells=False).cell
-        return SmearedStrain(cell, _transpose(cell), volume)
+        return SmearedStrain(cell, transpose_rows(cell), volume)
     cell, sub, order = subcell_gradients(rk, domains)
     owner = np.ascontiguousarray(domains.subcell_node[order])
     ptr = np.zeros(p.num_nodes + 1, np.int64)
     np.cumsum(np.bincount(owner, minlength=p.num_nodes), out=ptr[1:])
     area = domains.subcell_area[order]
-    stab = Stabilization(sub, _transpose(sub), ptr, owner, np.ascontiguousarray(area / volume[owner]),
+    stab = Stabilization(sub, transpose_rows(sub), ptr, owner, np.ascontiguousarray(area / volume[owner]),
                          np.ascontiguousarray(eps_p * area, dtype=np.float64))
-    op = SmearedStrain(cell, _transpose(cell), volume, stab)
+    op = SmearedStrain(cell, transpose_rows(cell), volume, stab)
     probe = np.random.default_rng(0).standard_normal(2 * p.num_nodes)
-    direct = _apply(cell, probe)
+    direct = row_strains(cell, probe)
     gap = np.abs(op.strain(probe) - direct).max() / max(np.abs(direct).max(), 1e-300)
     if not gap <= _PARTITION_TOL:
         raise InputError(f"the subcells do not partition the nodal cells (cell and subcell strains differ by "

@@ -116,9 +116,9 @@ def simulate(label: str, pl: Plate, model: dm.DamageModel, track: Tracking | Non
              checkpoint_every: int = 0, work_dir: Path | None = None, resume: Path | None = None,
              comm=None) -> DamageRun:
     """The damage particle method on the plate to ``t_end`` (``rkfx.models.damage_dynamics.run_damage``;
-    with an MPI ``comm`` of several ranks, rank 0 runs it)."""
+    with an MPI ``comm`` of several ranks, distributed over them)."""
     return run_damage(label, pl.op, pl.mass, pl.dt, model, track, constraints, t_end, external_force, samples,
-                      checkpoint_every, work_dir, resume, comm)
+                      checkpoint_every, work_dir, resume, comm, x=pl.p.x)
 
 
 def run_studies(results, studies: Sequence[tuple[str, Sequence, Callable]], summary: Callable) -> None:

@@ -449,7 +449,7 @@ class DamageUpdate:
 
 
 def initiate(model: DamageModel, points: np.ndarray, effective: np.ndarray, normal: np.ndarray,
-             chord: np.ndarray, kappa_c: np.ndarray) -> None:
+             chord: np.ndarray, kappa_c: np.ndarray, at: np.ndarray | None = None) -> None:
     """Fix the crack of damage points at initiation, in place.
 
     The crack normal n_L is the major principal direction of the effective stress C eps
@@ -463,11 +463,14 @@ def initiate(model: DamageModel, points: np.ndarray, effective: np.ndarray, norm
         normal: n_L of every point, shape ``(m, 2)``: rows ``points`` are written.
         chord: A_L of every point, shape ``(m,)`` [m]: written when regularized.
         kappa_c: Critical strains, shape ``(m,)``: written when regularized.
+        at: Where the points' values go in ``normal``, ``chord`` and ``kappa_c`` when these hold
+            a subset of the points (one rank's), shape ``(k,)``; default ``points``.
     """
-    normal[points] = principal_direction(effective)
+    at = points if at is None else at
+    normal[at] = principal_direction(effective)
     if model.regularized:
-        chord[points] = chord_lengths(model.geometry, points, normal[points])
-        kappa_c[points] = model.band_factor * critical_strain(model.material, chord[points], model.volume[points])
+        chord[at] = chord_lengths(model.geometry, points, normal[at])
+        kappa_c[at] = model.band_factor * critical_strain(model.material, chord[at], model.volume[points])
 
 
 def update(model: DamageModel, state: DamageState, strain: np.ndarray, tangent: bool = True,

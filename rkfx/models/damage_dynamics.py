@@ -59,6 +59,7 @@ from rkfx.fracture.damage import DamageModel, crack_opening, dissipation_density
 from rkfx.materials.damage_law import damage_kernel, strain_kernel
 from rkfx.errors import InputError
 from rkfx.parallel.ranks import on_root
+from rkfx.assembly.smeared_strain import SmearedStrain
 from rkfx.solvers.central_difference import CentralDifference, Constraint, ExplicitDynamics, ExplicitState
 from rkfx.solvers.checkpoint import copy_into, has_checkpoint, log, read_arrays, run_folder, save_arrays
 
@@ -183,15 +184,18 @@ class DamageForce:
         strain_kernel(e, self.c, self.nu_zz, f.allowed, f.damaged, self.kappa0, self._eq, self._effective,
                       self._crossing)
         f.clock[0] += self.dt
-        new = np.flatnonzero(self._crossing)
-        if new.size:
-            self._initiate(new)
+        self._initiate_all(np.flatnonzero(self._crossing))
         damage_kernel(self._eq, self._effective, f.allowed, f.damaged, self.kappa0, f.kappa_c, f.kappa, f.damage,
                       self.stress)
         if stab is None:
             return op.force(self.stress)
         _subcell_stress(diff, self.c, stab.owner, f.damage, diff)
         return op.force(self.stress, diff)
+
+    def _initiate_all(self, new: np.ndarray) -> None:
+        """The initiations of this evaluation (``rkfx.models.damage_ranks`` gathers them over ranks)."""
+        if new.size:
+            self._initiate(new)
 
     def _initiate(self, new: np.ndarray) -> None:
         """Fix n_L (major principal direction of C e, 4.22) and kappa_c (4.28) of the particles
@@ -232,8 +236,10 @@ class _Samples:
     damaged points and energies at every output, and the stepping time so far across the
     pieces of a resumed run; its arrays are checkpointed with the run."""
 
-    def __init__(self, dynamics: DamageDynamics, steps: int, every: int):
+    def __init__(self, dynamics: DamageDynamics, steps: int, every: int,
+                 total: Callable[[np.ndarray], np.ndarray] | None = None):
         self.field, self.model = dynamics.field, dynamics.damage_model
+        self.total = total  # sums a rank's (dissipated, damaged) over the ranks
         self.history = np.full((steps // every + 2, len(HISTORY)), np.nan)
         self.slot = np.zeros(1, np.int64)
         self.wall = np.zeros(1)
@@ -245,8 +251,10 @@ class _Samples:
             self.base = float(self.wall[0])
         self.wall[0] = self.base + time.perf_counter() - self.t0
         e = s.energy
-        self.history[self.slot[0]] = (s.time, self.field.dissipated(self.model), self.field.damaged.sum(),
-                                      e[0], e[1], e[2] + e[3])
+        damage = np.array([self.field.dissipated(self.model), self.field.damaged.sum()], float)
+        if self.total is not None:
+            damage = self.total(damage)
+        self.history[self.slot[0]] = (s.time, damage[0], damage[1], e[0], e[1], e[2] + e[3])
         self.slot[0] += 1
 
     def arrays(self) -> dict[str, np.ndarray]:
@@ -324,7 +332,7 @@ def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, mode
                track: Tracking | None, constraints: Sequence[Constraint], t_end: float,
                external_force: Callable[[float], np.ndarray] | None = None, samples: int = 200,
                checkpoint_every: int = 0, work_dir: Path | None = None, resume: Path | None = None,
-               comm=None) -> DamageRun:
+               comm=None, x: np.ndarray | None = None) -> DamageRun:
     """Explicit dynamics with the damage of ``model`` to ``t_end`` (``samples`` history points),
     keeping finished work.
 
@@ -338,11 +346,14 @@ def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, mode
         work_dir: Where finished results and checkpoints go.
         resume: Work directory of an interrupted invocation: a finished result there is
             returned as is, a checkpoint is continued.
-        comm: An MPI communicator (mpi4py) or ``None``. The run is serial: with several ranks,
-            rank 0 runs it and writes the files, and every rank receives the result (or the
-            error).
+        comm: An MPI communicator (mpi4py) or ``None``. With several ranks and the particle
+            positions ``x``, a ``SmearedStrain`` run is distributed (``rkfx.models.damage_ranks``:
+            the serial result bit for bit, on every rank); other runs are serial: rank 0 runs
+            them and writes the files, and every rank receives the result (or the error).
+        x: Particle positions, shape ``(n, 2)`` [m], which the ranks split by RCB.
     """
-    if comm is not None and comm.size > 1:
+    parallel = comm is not None and comm.size > 1
+    if parallel and (x is None or not isinstance(op, SmearedStrain)):
         return on_root(comm, lambda: run_damage(label, op, mass, dt, model, track, constraints, t_end,
                                                 external_force, samples, checkpoint_every, work_dir, resume))
     if not t_end > 0:
@@ -368,18 +379,27 @@ def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, mode
     checkpoint_dir = None if work_dir is None else Path(work_dir) / key
     if resume is not None and has_checkpoint(Path(resume) / key):
         start = Path(resume) / key
-    dynamics = DamageDynamics(op, mass, model, track, dt, constraints, external_force)
-    kept = _Samples(dynamics, steps, every)
+    if parallel:
+        from rkfx.models.damage_ranks import RankDamage  # noqa: PLC0415 - it builds on this module
+        from rkfx.parallel.partition import rcb  # noqa: PLC0415
+
+        dynamics = RankDamage(op, mass, model, track, dt, constraints, external_force, rcb(x, comm.size), comm)
+        whole, whole_nodes, total = dynamics.gather, dynamics.gather_nodes, dynamics.share.sum
+    else:
+        dynamics = DamageDynamics(op, mass, model, track, dt, constraints, external_force)
+        whole = whole_nodes = np.copy
+        total = None
+    kept = _Samples(dynamics, steps, every, total)
     res = CentralDifference(dt).run(dynamics, steps, output_every=every, recorder=kept,
                                     checkpoint_every=checkpoint_every, checkpoint_dir=checkpoint_dir, resume=start)
     elapsed = kept.elapsed
-    history, slot, field = kept.history, kept.slot, dynamics.field
+    history, slot, field, points = kept.history, kept.slot, dynamics.field, dynamics.damage_model
     if slot[0] == 0 or history[slot[0] - 1, 0] < steps * dt * (1 - 1e-12):
         kept.record(res.state)
-    run = DamageRun(label, history[:slot[0]].copy(), field.damage.copy(), field.kappa.copy(), field.normal.copy(),
-                    field.initiation_time.copy(), crack_opening(field.kappa, model.kappa0, field.kappa_c),
-                    field.dissipation(model), res.state.d.copy(), res.state.v.copy(), steps, dt, elapsed,
-                    res.relative_energy_error(), res.resumed_from)
+    run = DamageRun(label, history[:slot[0]].copy(), whole(field.damage), whole(field.kappa), whole(field.normal),
+                    whole(field.initiation_time), whole(crack_opening(field.kappa, points.kappa0, field.kappa_c)),
+                    whole(field.dissipation(points)), whole_nodes(res.state.d), whole_nodes(res.state.v), steps, dt,
+                    elapsed, res.relative_energy_error(), res.resumed_from)
     if checkpoint_dir is not None:
         run.save(checkpoint_dir / "result.npz")
     return run

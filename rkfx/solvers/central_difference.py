@@ -53,7 +53,7 @@ import scipy.sparse as sp
 
 from rkfx.errors import InputError
 from rkfx.linalg.linear_solver import linear_solver
-from rkfx.solvers.checkpoint import copy_into, load_arrays, restore_run, save_run
+from rkfx.solvers.checkpoint import EACH_RANK, copy_into, load_arrays, rank_folder, restore_run, save_run
 from rkfx.solvers.fields import FieldLayout, single
 from rkfx.solvers.model import Constraints, no_constraints
 
@@ -100,15 +100,19 @@ def _accelerate(f_ext, f_int, mass, vh, half, a, v):
 
 
 @numba.njit(parallel=True, cache=True)
-def _energy_increments(v, mass, dd, f_int0, f_int1, f_ext0, f_ext1, dv):
-    """(kinetic, internal, external, constraint) increments of a step (dv empty: no constraints)."""
+def _energy_increments(v, mass, dd, f_int0, f_int1, f_ext0, f_ext1, dv, share):
+    """(kinetic, internal, external, constraint) increments of a step (dv empty: no constraints;
+    ``share`` empty, or 1 on the unknowns this rank owns and 0 on its ghost copies)."""
     n = len(v)
     part = np.zeros((_CHUNKS, 4))
     size = (n + _CHUNKS - 1) // _CHUNKS
     with_dv = len(dv) > 0
+    shared = len(share) > 0
     for c in numba.prange(_CHUNKS):
         k = w = x = r = 0.0
         for i in range(c * size, min(n, (c + 1) * size)):
+            if shared and share[i] == 0.0:
+                continue
             k += mass[i] * v[i] * v[i]
             w += dd[i] * (f_int0[i] + f_int1[i])
             x += dd[i] * (f_ext0[i] + f_ext1[i])
@@ -188,6 +192,9 @@ class ExplicitModel(Protocol):
     layout: FieldLayout
     essential: Sequence[Constraint]
 
+    # Optional: ``share``, a ``RankShare`` when the model is one rank's part of a problem
+    # distributed over MPI ranks (its unknowns are local: owned and ghost copies).
+
     def lumped_mass(self) -> np.ndarray:
         """M per unknown, shape ``(size,)`` [kg], positive."""
 
@@ -203,6 +210,30 @@ class ExplicitModel(Protocol):
 
     def restore(self, arrays: Mapping[str, np.ndarray]) -> None:
         """Set the history from ``state()`` arrays."""
+
+
+class RankShare(Protocol):
+    """A rank's part of an explicit model distributed over MPI ranks.
+
+    The model's vectors are local: the unknowns the rank owns and ghost copies of unknowns
+    owned elsewhere, which its internal force keeps equal to the owners' (a halo exchange),
+    so the stepper's updates keep them equal too. Energies sum the owned unknowns over the
+    ranks; checkpoints are one file per rank.
+
+    Attributes:
+        owned: 1.0 on owned unknowns, 0.0 on ghost copies, shape ``(size,)``.
+        rank, size: This rank and the number of ranks.
+    """
+
+    owned: np.ndarray
+    rank: int
+    size: int
+
+    def sum(self, values: np.ndarray) -> np.ndarray:
+        """``values`` summed over the ranks (collective)."""
+
+    def least(self, value: int) -> int:
+        """The smallest ``value`` over the ranks (collective)."""
 
 
 class ExplicitBase:
@@ -449,6 +480,10 @@ class Workspace:
         if self.mass.shape != (n,):
             raise InputError(f"lumped mass has shape {self.mass.shape} for the {n} unknowns of the model's layout")
         self.proj = _Projection(model.essential, self.mass)
+        self.share = getattr(model, "share", None)
+        self.owned = np.empty(0) if self.share is None else np.ascontiguousarray(self.share.owned, dtype=np.float64)
+        if self.share is not None and self.owned.shape != (n,):
+            raise InputError(f"the model's share marks {self.owned.size} unknowns as owned or ghost; it has {n}")
         self.d_new, self.a_new, self.vh, self.dd = (np.empty(n) for _ in range(4))
         self.zeros = np.zeros(n)
         self.no_dv = np.empty(0)
@@ -456,6 +491,17 @@ class Workspace:
     def external_force(self, t: float) -> np.ndarray:
         f = self.model.external_force(t)
         return self.zeros if f is None else _vector(f, self.size, "external_force(t)")
+
+    def total(self, values: np.ndarray) -> np.ndarray:
+        """Energies of this rank's unknowns summed over the ranks (as is on one)."""
+        return values if self.share is None else np.asarray(self.share.sum(values), float)
+
+    def folder(self, directory: str | Path | None) -> Path | None:
+        """This rank's checkpoint folder in ``directory``: itself on one rank, else
+        ``rank<r>-of-<P>/`` (``rkfx.solvers.checkpoint.rank_folder``)."""
+        if directory is None or self.share is None or self.share.size == 1:
+            return None if directory is None else Path(directory)
+        return rank_folder(directory, self.share.rank, self.share.size)
 
 
 @dataclass(frozen=True)
@@ -488,7 +534,8 @@ class CentralDifference:
         f_int = _vector(model.internal_force(d), n, "internal_force(d)")
         f_ext = work.external_force(0.0)
         a = (f_ext - f_int) / mass
-        energy = np.array([0.5 * _wdot(v, mass, v), 0.0, 0.0, 0.0])
+        kinetic = 0.5 * (_wdot(v, mass, v) if work.share is None else _wdot(v, mass * work.owned, v))
+        energy = work.total(np.array([kinetic, 0.0, 0.0, 0.0]))
         return ExplicitState(0, 0.0, d, v, a, f_int, f_ext, energy)
 
     def advance(self, model: ExplicitModel, s: ExplicitState, work: Workspace) -> None:
@@ -509,7 +556,7 @@ class CentralDifference:
             # Constraint force over the step: the impulses of the half-step projection and of
             # the full-step one at its end (each carries half of it for a steady reaction).
             dv = dv + proj.project(s.v, proj.velocity_target(t_next, dt))
-        inc = _energy_increments(s.v, mass, work.dd, s.f_int, f_int, s.f_ext, f_ext, dv)
+        inc = work.total(_energy_increments(s.v, mass, work.dd, s.f_int, f_int, s.f_ext, f_ext, dv, work.owned))
         e = s.energy
         s.energy = np.array([inc[0], e[1] + inc[1], e[2] + inc[2], e[3] + inc[3] / dt])
         s.d, work.d_new = work.d_new, s.d
@@ -548,8 +595,10 @@ class CentralDifference:
         hist_t = np.empty(num_steps + 1)
         hist_e = np.empty((num_steps + 1, len(ENERGIES)))
         resumed = None
+        checkpoint_dir = work.folder(checkpoint_dir)
+        writer = None if work.share is None or work.share.size == 1 else EACH_RANK
         if resume is not None:
-            ck = load_arrays(resume)
+            ck = load_arrays(work.folder(resume), common=None if writer is None else work.share.least)
             if ck["d"].shape != (n,) or float(ck["dt"]) != dt:
                 raise InputError(f"checkpoint in {str(resume)!r} has {ck['d'].size} unknowns and dt = "
                                  f"{float(ck['dt']):.6g}; this problem has {n} and dt = {dt:.6g}")
@@ -582,7 +631,8 @@ class CentralDifference:
                 record(s)
             if checkpoint_every and done % checkpoint_every == 0:
                 save_run(checkpoint_dir, s.arrays(dt) | {"history_time": hist_t[:done + 1],
-                                                         "history_energy": hist_e[:done + 1]}, model, recorder)
+                                                         "history_energy": hist_e[:done + 1]}, model, recorder,
+                         comm=writer)
         wall = _time.perf_counter() - t_wall
         final = ExplicitState(num_steps, num_steps * dt, s.d, s.v, s.a, s.f_int.copy(), s.f_ext.copy(), s.energy)
         return ExplicitResult(final, dt, hist_t, hist_e, snapshots, resumed, wall)

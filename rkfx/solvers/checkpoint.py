@@ -12,7 +12,7 @@ import shutil
 import sys
 import zipfile
 import zlib
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +22,29 @@ from rkfx.errors import InputError
 CHECKPOINT = "checkpoint.npz"
 PREVIOUS = "checkpoint.previous.npz"  # the checkpoint before the newest
 log = logging.getLogger("rkfx")
+
+
+class _EachRank:
+    """Passed as ``comm``: the calling rank writes its own file (one file per rank)."""
+
+    rank = 0
+
+
+EACH_RANK = _EachRank()
+
+
+def rank_folder(directory: str | Path, rank: int, size: int) -> Path:
+    """The folder of rank ``rank``'s files of a run on ``size`` ranks: ``DIR/rank<r>-of-<P>``."""
+    return Path(directory) / f"rank{rank}-of-{size}"
+
+
+def _written_on(directory: Path) -> int | None:
+    """On how many ranks the checkpoints in ``directory`` (a run's folder) were written, if any."""
+    if any((directory / n).is_file() for n in (CHECKPOINT, PREVIOUS)):
+        return 1
+    sizes = {int(d.name.rsplit("-of-", 1)[1]) for d in directory.glob("rank*-of-*") if d.is_dir()
+             and d.name.rsplit("-of-", 1)[1].isdigit() and has_checkpoint(d)} if directory.is_dir() else set()
+    return min(sizes) if sizes else None
 
 
 def writes(comm) -> bool:
@@ -75,8 +98,13 @@ def run_folder(label: str) -> str:
 
 
 def has_checkpoint(directory: str | Path | None) -> bool:
-    """Whether ``directory`` holds a checkpoint to resume from (the newest or the previous one)."""
-    return directory is not None and any((Path(directory) / n).is_file() for n in (CHECKPOINT, PREVIOUS))
+    """Whether ``directory`` holds a checkpoint to resume from (the newest or the previous one,
+    or one per rank in ``rank<r>-of-<P>/`` folders)."""
+    if directory is None:
+        return False
+    directory = Path(directory)
+    return any((directory / n).is_file() for n in (CHECKPOINT, PREVIOUS)) or \
+        any(has_checkpoint(d) for d in directory.glob("rank*-of-*") if d.is_dir())
 
 
 def read_arrays(path: str | Path) -> dict[str, np.ndarray]:
@@ -92,12 +120,52 @@ def read_arrays(path: str | Path) -> dict[str, np.ndarray]:
                          "that run again, or resume without it") from None
 
 
-def load_arrays(directory: str | Path) -> dict[str, np.ndarray]:
+def _step(arrays: Mapping[str, np.ndarray]) -> int | None:
+    return next((int(v) for k, v in arrays.items() if k.split("__")[-1] == "step" and np.ndim(v) == 0), None)
+
+
+def load_arrays(directory: str | Path, common: Callable[[int], int] | None = None) -> dict[str, np.ndarray]:
     """The arrays of the newest readable checkpoint in ``directory`` (logged as a resume, with its
-    step, on logger ``rkfx``): ``CHECKPOINT``, else ``PREVIOUS`` with a warning naming why."""
+    step, on logger ``rkfx``): ``CHECKPOINT``, else ``PREVIOUS`` with a warning naming why.
+
+    ``common``: for one file per rank, the smallest of a step over the ranks (collective). The
+    ranks agree on the newest step they all hold (a run killed while the ranks wrote a
+    checkpoint leaves some of them one checkpoint ahead) and read that one.
+    """
     directory = Path(directory)
+    if common is None:
+        return _load_newest(directory)
+    try:
+        arrays, error = _load_newest(directory), None
+    except InputError as err:
+        arrays, error = None, err
+    mine = -1 if arrays is None else _step(arrays)
+    agreed = common(mine)
+    if agreed < 0:
+        raise error or InputError(f"another rank cannot read its checkpoint beside {directory}; see its message")
+    if mine != agreed:
+        previous = directory / PREVIOUS
+        arrays = read_arrays(previous) if previous.is_file() else {}
+        if _step(arrays) != agreed:
+            raise InputError(f"the ranks' checkpoints in {directory.parent} share no step ({directory.name} is at "
+                             f"step {mine}, another rank at {agreed}); delete {directory.parent} to compute that "
+                             "run again")
+        log.info("resume: %s continues from step %s, the newest step of every rank", directory.name, agreed)
+    return arrays
+
+
+def _load_newest(directory: Path) -> dict[str, np.ndarray]:
     newest, previous = directory / CHECKPOINT, directory / PREVIOUS
-    if not has_checkpoint(directory):
+    if not (newest.is_file() or previous.is_file()):
+        per_rank = "-of-" in directory.name and directory.name.startswith("rank")
+        run = directory.parent if per_rank else directory
+        now = int(directory.name.rsplit("-of-", 1)[1]) if per_rank else 1
+        ranks = _written_on(run)
+        if ranks is not None and ranks != now:
+            how = f"on {ranks} ranks" if ranks > 1 else "serially"
+            again = f"mpiexec -n {ranks} ..." if ranks > 1 else "without mpiexec"
+            raise InputError(f"the checkpoint in {run} was written {how}, this run has {now} rank(s); resume "
+                             f"{again}, or delete {run} to compute that run again")
         raise InputError(f"no checkpoint at {str(newest)!r}; run with a checkpoint interval and folder first")
     try:
         arrays = read_arrays(newest) if newest.is_file() else None
@@ -112,7 +180,7 @@ def load_arrays(directory: str | Path) -> dict[str, np.ndarray]:
         except InputError:
             raise InputError(f"{newest} and {previous.name} beside it are unreadable; delete {directory} to "
                              "compute that run again") from None
-    step = next((int(v) for k, v in arrays.items() if k.split("__")[-1] == "step" and np.ndim(v) == 0), None)
+    step = _step(arrays)
     log.info("resume: %s continues from step %s", directory.name, "?" if step is None else step)
     return arrays
 

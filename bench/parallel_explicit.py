@@ -1,0 +1,75 @@
+"""Benchmark: Kalthoff's impact problem by the damage particle method, serially and over MPI ranks.
+
+The regularized model of ``rkfx.cases.kalthoff`` with tracking at ``--nodes`` particles per side
+(450: 202,950 particles) through ``--t-end``. On more than one rank the run is distributed
+(``rkfx.models.damage_ranks``). Prints the set-up and stepping wall times (the largest over the
+ranks), each rank's peak RSS and, against a serial run
+saved with ``--save``, whether the damage, crack openings and displacements are the same bit
+for bit and the largest relative difference of the dissipation history.
+
+Usage:
+    python bench/parallel_explicit.py [--nodes 450] [--t-end 8e-5] [--save serial.npz]
+    mpiexec -n 2 python bench/parallel_explicit.py --compare serial.npz
+The cases give each rank its share of the cores for numba; set NUMBA_NUM_THREADS to choose.
+The last line reads ``<ranks> ranks x <threads> threads, <N> particles: <seconds> s stepping``.
+"""
+import argparse
+import resource
+import time
+
+import dolfinx_solver  # noqa: F401  (before mpi4py)
+import numba
+import numpy as np
+from mpi4py import MPI
+
+from rkfx.cases import _dynamic_fracture as dyn
+from rkfx.cases import kalthoff as k
+from rkfx.fracture import damage as dm
+from rkfx.parallel.threads import share_cores
+from rkfx.warmup import warm_up
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--nodes", type=int, default=450, help="particles per side")
+    ap.add_argument("--t-end", type=float, default=80e-6, help="end time [s]")
+    ap.add_argument("--save", help="write the run's results (rank 0) to this .npz file")
+    ap.add_argument("--compare", help="compare with the results saved by --save")
+    args = ap.parse_args()
+    comm = MPI.COMM_WORLD
+    if comm.size > 1:
+        share_cores(comm)
+    warm_up()
+    k.run(methods=("rkpm",), nodes=[40], unregularized_nodes=[], no_tracking_nodes=[], fem_nodes=[],
+          t_end=5e-6)  # compile the step kernels
+    prm = {name: spec.default for name, spec in k.PARAMS.items()}
+    material = dm.DamageMaterial(prm["E"], prm["nu"], prm["ft"], prm["GF"], "strain")
+    comm.Barrier()
+    t0 = time.perf_counter()
+    pl, track, model = k.setup(args.nodes, material, prm)
+    setup = time.perf_counter() - t0
+    run = dyn.simulate("bench", pl, model, track, k.model_conditions(pl, prm["v0"]), args.t_end, comm=comm)
+    stepping = comm.allreduce(run.wall_time_s, op=MPI.MAX)
+    setup = comm.allreduce(setup, op=MPI.MAX)
+    rss = comm.gather(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20)  # GB (ru_maxrss in kB)
+    n = pl.p.num_nodes
+    if comm.rank == 0:
+        print(f"{n:,} particles, {run.steps} steps to {1e6 * args.t_end:.0f} us; set-up {setup:.1f} s, stepping "
+              f"{stepping:.1f} s ({1e3 * stepping / run.steps:.2f} ms per step)")
+        print("peak RSS per rank [GB]: " + ", ".join(f"{r:.2f}" for r in rss))
+        print(f"dissipated {run.history[-1, 1]:.1f} J/m, cracked particles {int((run.opening >= 0.5).sum())}")
+        if args.save:
+            np.savez(args.save, damage=run.damage, opening=run.opening, displacement=run.displacement,
+                     history=run.history)
+        if args.compare:
+            ref = np.load(args.compare)
+            same = all(np.array_equal(ref[key], getattr(run, key)) for key in ("damage", "opening", "displacement"))
+            gap = np.abs(ref["history"][:, 1] - run.history[:, 1]).max() / max(np.abs(ref["history"][:, 1]).max(),
+                                                                            1e-300)
+            print(f"against {args.compare}: damage, openings and displacements "
+                  f"{'identical' if same else 'DIFFERENT'}; dissipation history within {gap:.1e}")
+        print(f"{comm.size} ranks x {numba.get_num_threads()} threads, {n} particles: {stepping:.1f} s stepping")
+
+
+if __name__ == "__main__":
+    main()

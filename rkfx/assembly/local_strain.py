@@ -1,0 +1,192 @@
+"""One rank's share of the smeared strain operator: strains at its particles, forces on its nodes.
+
+Explicit dynamics over MPI ranks (``rkfx.models.damage_ranks``) splits the particles over
+the ranks (``rkfx.parallel.partition``). A rank owns its particles: the damage points there,
+their rows of B~ (with the MSCNI subcell rows, ``rkfx.assembly.smeared_strain``) and the
+unknowns of their nodes. Its *local nodes* are its own and its ghost nodes: the nodes in the
+supports of its rows, and any the caller adds (the columns of the essential conditions).
+Its *local rows* are its own and the ghost rows: rows of other ranks' particles that touch
+one of its nodes.
+
+One force evaluation, on local vectors (interleaved over the local nodes):
+
+1. ``strains(d)``: the strains of the owned rows, from local coefficients only;
+2. the caller turns them into stresses at its points (a damage law);
+3. ``force(stress, ...)``: the loads of the owned rows (the stresses, or the subcell loads
+   tau_C of ``Stabilization``), a halo exchange that brings those of the ghost rows, the
+   transposed product for the owned nodes, and a halo exchange of the force at the ghost
+   nodes (``rkfx.parallel.halo``).
+
+Every sum runs over the same entries in the same order as the serial operator's, so the
+strains and forces equal the serial ones bit for bit, and so does a whole explicit run on
+any number of ranks. Today the global operator is built on every rank and sliced here; each
+rank keeps its slice only.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from rkfx.approximation.sparse_rows import SparseRows
+from rkfx.assembly.smeared_strain import (SmearedStrain, cell_average, row_strains, subcell_load,
+                                          transposed_force)
+from rkfx.errors import InputError
+from rkfx.parallel.halo import Halo, halo
+
+
+@dataclass(frozen=True)
+class LocalStabilization:
+    """What a damage force reads of the local MSCNI terms.
+
+    Attributes:
+        owner: Owned point (index among the owned points) of each owned row, ``(num_owned_rows,)``.
+    """
+
+    owner: np.ndarray
+
+
+@dataclass(frozen=True)
+class LocalSmearedStrain:
+    """A rank's share of a ``SmearedStrain`` (see the module docstring).
+
+    Attributes:
+        nodes: Global index of every local node, ascending, shape ``(num_local,)``.
+        owned_nodes: Local index of every owned node, ascending, shape ``(num_owned,)``.
+        points: Global index of every owned point (= owned particle), ascending, ``(num_owned,)``.
+        rows: The owned rows over the local nodes (the serial rows' entries in their order).
+        ptr: Owned point k has the owned rows ``ptr[k]:ptr[k + 1]``.
+        fraction, weight: A_C / A_L and eps_p A_C of each owned row (MSCNI), else ``None``.
+        volume: V_L of each owned point [m^2].
+        rows_t: For each owned node, its entries over the local rows (transposed, row order).
+        row_weight: Weight of each local row in the transposed product (1, or V_L without MSCNI).
+        owned_rows: Local index of each owned row among the local rows.
+        node_halo, row_halo: The exchanges of ghost nodes and ghost rows.
+        stabilization: The MSCNI terms' owners, or ``None`` (plain SCNI).
+    """
+
+    nodes: np.ndarray
+    owned_nodes: np.ndarray
+    points: np.ndarray
+    rows: SparseRows
+    ptr: np.ndarray
+    fraction: np.ndarray | None
+    weight: np.ndarray | None
+    volume: np.ndarray
+    rows_t: SparseRows
+    row_weight: np.ndarray
+    owned_rows: np.ndarray
+    node_halo: Halo
+    row_halo: Halo
+    stabilization: LocalStabilization | None
+
+    @property
+    def num_nodes(self) -> int:
+        """The number of damage points of this rank (its owned particles)."""
+        return len(self.points)
+
+    @property
+    def num_local(self) -> int:
+        return len(self.nodes)
+
+    @property
+    def dofs(self) -> np.ndarray:
+        """Global interleaved unknowns of the local nodes, shape ``(2 num_local,)``."""
+        return (2 * self.nodes[:, None] + np.arange(2)).ravel()
+
+    @property
+    def owned_dofs(self) -> np.ndarray:
+        """1.0 on the local unknowns of owned nodes, 0.0 on ghost copies, ``(2 num_local,)``."""
+        w = np.zeros((self.num_local, 2))
+        w[self.owned_nodes] = 1.0
+        return w.ravel()
+
+    def strain(self, d: np.ndarray) -> np.ndarray:
+        """Smeared strains at the owned points, shape ``(num_owned, 3)``, for local d."""
+        if self.stabilization is not None:
+            return self.strains(d)[0]
+        return row_strains(self.rows, d)
+
+    def strains(self, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The smeared strains ``(num_owned, 3)`` and the MSCNI differences per owned row."""
+        if self.stabilization is None:
+            raise InputError("this operator has no MSCNI terms; build it with smeared_strain(..., eps_p=1)")
+        sub = row_strains(self.rows, d)
+        return cell_average(self.ptr, self.fraction, sub), sub
+
+    def force(self, stress: np.ndarray, subcell_stress: np.ndarray | None = None) -> np.ndarray:
+        """f_int on the local nodes, shape ``(2 num_local,)`` [N], from the stresses at the owned
+        points (and the MSCNI subcell stresses of the owned rows). Collective."""
+        stress = np.ascontiguousarray(stress, dtype=np.float64)
+        load = np.zeros((len(self.row_weight), 3))
+        if self.stabilization is None:
+            load[self.owned_rows] = stress
+        else:
+            sub = np.empty((0, 3)) if subcell_stress is None else \
+                np.ascontiguousarray(subcell_stress, dtype=np.float64)
+            tau = np.empty((len(self.owned_rows), 3))
+            subcell_load(self.ptr, self.fraction, self.weight, self.volume, stress, sub, tau)
+            load[self.owned_rows] = tau
+        self.row_halo.exchange(load)
+        f = np.zeros((self.num_local, 2))
+        f[self.owned_nodes] = transposed_force(self.rows_t, load, self.row_weight).reshape(-1, 2)
+        return self.node_halo.exchange(f).ravel()
+
+
+def _ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """The concatenation of ``arange(s, s + c)`` over ``zip(starts, counts)``."""
+    total = int(counts.sum())
+    offsets = np.repeat(starts - np.concatenate([[0], np.cumsum(counts)[:-1]]), counts)
+    return offsets + np.arange(total)
+
+
+def _local(global_ids: np.ndarray, among: np.ndarray) -> np.ndarray:
+    """Positions of ``global_ids`` in the ascending array ``among`` (all present)."""
+    return np.searchsorted(among, global_ids)
+
+
+def local_smeared_strain(op: SmearedStrain, part: np.ndarray, comm, extra_nodes=()) -> LocalSmearedStrain:
+    """The share of ``comm.rank`` of ``op`` for the particle parts ``part`` (collective).
+
+    Args:
+        op: The whole operator (points = particles).
+        part: Rank of each particle, shape ``(n,)`` (e.g. ``rkfx.parallel.partition.rcb``).
+        comm: The communicator (mpi4py).
+        extra_nodes: Further nodes to keep as ghosts (e.g. every column of the constraints).
+    """
+    part = np.asarray(part, np.int64)
+    n = op.num_nodes
+    if part.shape != (n,):
+        raise InputError(f"particle parts have shape {part.shape}; expected ({n},)")
+    s = op.stabilization
+    if s is not None:
+        rows, rows_t, ptr, row_point = s.rows, s.rows_t, s.ptr, s.owner
+    else:
+        rows, rows_t, ptr, row_point = op.rows, op.rows_t, np.arange(n + 1), np.arange(n)
+    mine = np.flatnonzero(part == comm.rank)
+    counts = ptr[mine + 1] - ptr[mine]
+    orows = _ranges(ptr[mine], counts)
+    entries = _ranges(rows.indptr[orows], np.diff(rows.indptr)[orows])
+    cols = rows.indices[entries]
+    nodes = np.union1d(np.union1d(mine, cols), np.asarray(extra_nodes, np.int64))
+    indptr = np.zeros(len(orows) + 1, np.int64)
+    np.cumsum(np.diff(rows.indptr)[orows], out=indptr[1:])
+    local_rows = SparseRows(indptr, _local(cols, nodes).astype(np.int32), np.ascontiguousarray(rows.data[entries]),
+                            len(nodes))
+    # The rows touching an owned node, through the transposed entries (each node's in row order).
+    t_counts = np.diff(rows_t.indptr)[mine]
+    t_entries = _ranges(rows_t.indptr[mine], t_counts)
+    trows = rows_t.indices[t_entries].astype(np.int64)
+    lrows = np.union1d(orows, trows)
+    t_indptr = np.zeros(len(mine) + 1, np.int64)
+    np.cumsum(t_counts, out=t_indptr[1:])
+    local_t = SparseRows(t_indptr, _local(trows, lrows).astype(np.int32),
+                         np.ascontiguousarray(rows_t.data[t_entries]), len(lrows))
+    row_weight = np.ones(len(lrows)) if s is not None else np.ascontiguousarray(op.volume[row_point[lrows]])
+    point_ptr = np.zeros(len(mine) + 1, np.int64)
+    np.cumsum(counts, out=point_ptr[1:])
+    stab = None if s is None else LocalStabilization(np.repeat(np.arange(len(mine)), counts))
+    return LocalSmearedStrain(
+        nodes, _local(mine, nodes), mine, local_rows, point_ptr,
+        None if s is None else np.ascontiguousarray(s.fraction[orows]),
+        None if s is None else np.ascontiguousarray(s.weight[orows]),
+        np.ascontiguousarray(op.volume[mine]), local_t, row_weight, _local(orows, lrows),
+        halo(nodes, part[nodes], comm), halo(lrows, part[row_point[lrows]], comm), stab)

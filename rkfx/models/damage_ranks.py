@@ -1,0 +1,148 @@
+"""The damage particle method on MPI ranks: every rank steps its own particles.
+
+The particles are split by recursive coordinate bisection (``rkfx.parallel.partition``).
+Each rank owns the damage points at its particles and the unknowns of their nodes, and keeps
+ghost copies of the nodes its strains read and of the constraint columns
+(``rkfx.assembly.local_strain``). One step of ``rkfx.solvers.central_difference`` then runs
+on the rank's local vectors as it would serially; per step the ranks exchange:
+
+* the loads of the rows that couple to another rank's nodes, and the internal force at the
+  ghost nodes (two neighbour-only halo exchanges, ``rkfx.parallel.halo``);
+* when a particle initiates anywhere, the new crack particles and their normals (one small
+  all-gather), so that every rank marks the same tracking candidates (4.22), in the serial
+  order, also across the partition boundaries; whether any initiated is one all-reduce of a
+  count per step (with tracking on);
+* the energies and the history samples (all-reduces of a few numbers).
+
+The constraint rows are replicated (the columns of G are ghosts everywhere), so every rank
+solves the same small projection. Every strain, force and damage update is the serial
+one's, entry for entry in the same order, so a run on any number of ranks gives the serial
+damage, crack paths and displacements bit for bit; only the summed energies and dissipation
+may differ in the last digits (sums in another order). Checkpoints are one file per rank
+(``rank<r>-of-<P>/``, resumable on the same number of ranks); finished results are gathered
+and written once.
+"""
+import numpy as np
+
+from rkfx.assembly.local_strain import LocalSmearedStrain, local_smeared_strain
+from rkfx.fracture.damage import DamageModel, initiate
+from rkfx.fracture.tracking import Tracking
+from rkfx.models.damage_dynamics import DamageDynamics, DamageForce, damage_field
+from rkfx.solvers.central_difference import Constraint, ExplicitDynamics
+
+
+class MpiShare:
+    """``rkfx.solvers.central_difference.RankShare`` over an mpi4py communicator."""
+
+    def __init__(self, comm, owned: np.ndarray):
+        self.comm, self.owned = comm, owned
+        self.rank, self.size = comm.rank, comm.size
+
+    def sum(self, values: np.ndarray) -> np.ndarray:
+        from mpi4py import MPI  # noqa: PLC0415 - loaded already: the communicator is one
+
+        out = np.ascontiguousarray(values, dtype=np.float64).copy()
+        self.comm.Allreduce(MPI.IN_PLACE, out, op=MPI.SUM)
+        return out
+
+    def least(self, value: int) -> int:
+        return int(min(self.comm.allgather(int(value))))
+
+
+def restricted(model: DamageModel, points: np.ndarray) -> DamageModel:
+    """The data of ``points`` of ``model`` (the cell geometry stays whole: it is read by the
+    global indices of initiating points)."""
+    return DamageModel(model.material, model.volume[points], model.kappa0[points], model.geometry,
+                       None if model.kappa_c is None else model.kappa_c[points], model.band_factor)
+
+
+class RankDamageForce(DamageForce):
+    """``DamageForce`` of one rank's points: initiations are gathered over the ranks, so the
+    tracking state (which particles may initiate, and their parents) is the same everywhere."""
+
+    def __init__(self, op: LocalSmearedStrain, model: DamageModel, local_model: DamageModel, field,
+                 track: Tracking | None, dt: float, comm):
+        super().__init__(op, local_model, field, track, dt)
+        self.whole, self.comm = model, comm
+        n = model.num_points
+        tracked = track is not None and track.enabled
+        self.allowed = track.seeds.copy() if tracked else np.ones(n, bool)
+        self.parent = np.full(n, -1, np.int64)
+        self.tracked = tracked
+        self._count = np.zeros(1, np.int64)
+
+    def _anywhere(self, count: int) -> bool:
+        """Whether any rank has initiations in this evaluation (an all-reduce of one number)."""
+        from mpi4py import MPI  # noqa: PLC0415 - loaded already: the communicator is one
+
+        self._count[0] = count
+        self.comm.Allreduce(MPI.IN_PLACE, self._count, op=MPI.SUM)
+        return bool(self._count[0])
+
+    def _initiate_all(self, new: np.ndarray) -> None:
+        f, points = self.field, self.op.points
+        if new.size:
+            initiate(self.whole, points[new], self._effective[new], f.normal, f.chord, f.kappa_c, at=new)
+            f.damaged[new] = True
+            f.initiation_time[new] = f.clock[0]
+        if not self.tracked or not self._anywhere(new.size):
+            return
+        pieces = self.comm.allgather((points[new], f.normal[new]))
+        ids = np.concatenate([p[0] for p in pieces])
+        order = np.argsort(ids, kind="stable")  # ascending, as serially
+        cand, by = self.track.candidates(ids[order], np.concatenate([p[1] for p in pieces])[order], self.parent)
+        fresh = ~self.allowed[cand]
+        self.parent[cand[fresh]] = by[fresh]
+        self.allowed[cand] = True
+        f.allowed[:] = self.allowed[points]
+        f.parent[:] = self.parent[points]
+
+
+class RankDamage(DamageDynamics):
+    """One rank's part of a ``DamageDynamics`` problem (the module docstring says how).
+
+    Args:
+        op, mass, model, track, dt, constraints, external_force: The whole problem, as for
+            ``DamageDynamics`` (``op`` a ``SmearedStrain``).
+        part: Rank of each particle, shape ``(n,)``.
+        comm: The communicator (mpi4py).
+    """
+
+    def __init__(self, op, mass, model: DamageModel, track: Tracking | None, dt: float, constraints, external_force,
+                 part: np.ndarray, comm):
+        columns = np.unique(np.concatenate([c.G.indices // 2 for c in constraints])) if constraints else []
+        local = local_smeared_strain(op, part, comm, extra_nodes=columns)
+        points, dofs = local.points, local.dofs
+        self.op, self.damage_model = local, restricted(model, points)
+        self.field = damage_field(self.damage_model, None, dt)
+        self.force = RankDamageForce(local, model, self.damage_model, self.field, track, dt, comm)
+        self.field.allowed[:] = self.force.allowed[points]
+        essential = [Constraint(_columns(c.G, dofs), c.displacement, c.velocity) for c in constraints]
+        f_ext = None if external_force is None else (lambda t: np.asarray(external_force(t))[dofs])
+        ExplicitDynamics.__init__(self, np.asarray(mass)[dofs], self.force, dt, f_ext, essential,
+                                  self.field.arrays | {"allowed_all": self.force.allowed,
+                                                       "parent_all": self.force.parent})
+        self.share = MpiShare(comm, local.owned_dofs)
+        self.comm, self.num_points = comm, op.num_nodes
+
+    def gather(self, values: np.ndarray) -> np.ndarray:
+        """The whole array of a per-point quantity from every rank's owned points (collective)."""
+        pieces = self.comm.allgather((self.op.points, np.asarray(values)))
+        out = np.empty((self.num_points, *pieces[0][1].shape[1:]), pieces[0][1].dtype)
+        for points, v in pieces:
+            out[points] = v
+        return out
+
+    def gather_nodes(self, local: np.ndarray) -> np.ndarray:
+        """The whole interleaved vector ``(2 n,)`` from the local vectors of every rank (collective)."""
+        owned = np.asarray(local).reshape(-1, 2)[self.op.owned_nodes]
+        return self.gather(owned).ravel()
+
+
+def _columns(g, dofs: np.ndarray):
+    """``g`` on the local unknowns ``dofs`` (ascending, holding every column of ``g``), each row's
+    entries kept in their order, so that G w sums as serially."""
+    import scipy.sparse as sp  # noqa: PLC0415
+
+    g = sp.csr_matrix(g)
+    return sp.csr_matrix((g.data, np.searchsorted(dofs, g.indices), g.indptr), shape=(g.shape[0], len(dofs)))

@@ -1,0 +1,82 @@
+"""Explicit fracture runs distributed over MPI ranks (``rkfx.models.damage_ranks``) are the
+serial runs: the same damaged particles, damage and crack openings bit for bit, the same
+crack angles and dissipation histories to round-off; a run killed on 2 ranks resumes on 2
+ranks to the uninterrupted result, and a resume on another number of ranks is refused in
+one line."""
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+MPIEXEC = Path(sys.executable).parent / "mpiexec"
+ROOT = Path(__file__).resolve().parents[1]
+KILLED_RUN = ROOT / "tests" / "faults" / "killed_run.py"
+sys.path.insert(0, str(ROOT / "tests" / "faults"))
+from killed_run import ARGS  # noqa: E402  (a small Kalthoff invocation)
+
+pytestmark = [pytest.mark.mpi,
+              pytest.mark.skipif(not MPIEXEC.exists() and shutil.which("mpiexec") is None, reason="no mpiexec")]
+ENV = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
+
+
+def mpiexec(ranks: int, *args, check=True):
+    launcher = str(MPIEXEC) if MPIEXEC.exists() else "mpiexec"
+    cmd = [sys.executable, *args] if ranks == 1 else [launcher, "-n", str(ranks), sys.executable, *args]
+    return subprocess.run(cmd, env=ENV, capture_output=True, text=True, timeout=600, check=check)
+
+
+def kalthoff(ranks: int, out: Path, *extra, check=True):
+    return mpiexec(ranks, "-m", "rkfx.cases.kalthoff", *ARGS, "--out", str(out), *extra, check=check)
+
+
+def runs(out: Path) -> dict:
+    return {r["method"]: r for r in json.loads((out / "results.json").read_text())["runs"]}
+
+
+def assert_same_runs(a: dict, b: dict) -> None:
+    assert list(a) == list(b)
+    for name, ra in a.items():
+        rb = b[name]
+        for key in ("damaged_index", "damaged_D", "damaged_w"):
+            assert ra["series"].get(key) == rb["series"].get(key), (name, key)
+        for key in ("dissipated", "damaged", "kinetic", "internal", "external"):
+            if key in ra["series"]:
+                x, y = np.asarray(ra["series"][key], float), np.asarray(rb["series"][key], float)
+                assert np.abs(x - y).max() <= 1e-10 * max(np.abs(x).max(), 1e-300), (name, key)
+        for key, value in ra["errors"].items():
+            if key != "energy_error" and isinstance(value, float):
+                assert value == pytest.approx(rb["errors"][key], rel=1e-10, abs=1e-12), (name, key)
+
+
+@pytest.fixture(scope="module")
+def serial(tmp_path_factory):
+    out = tmp_path_factory.mktemp("serial")
+    kalthoff(1, out)
+    return runs(out)
+
+
+@pytest.mark.parametrize("ranks", [2, 3])
+def test_kalthoff_on_ranks_is_the_serial_run(serial, tmp_path, ranks):
+    done = kalthoff(ranks, tmp_path / "run")
+    assert done.stdout.count("results:") == 1
+    assert_same_runs(serial, runs(tmp_path / "run"))
+    run = next(d for d in (tmp_path / "run" / "checkpoints").iterdir() if d.is_dir())
+    assert sorted(p.name for p in run.iterdir() if p.is_dir()) == [f"rank{r}-of-{ranks}" for r in range(ranks)]
+    assert (run / "result.npz").is_file()  # finished results are gathered and written once
+
+
+def test_killed_on_two_ranks_resumes_on_two_ranks(serial, tmp_path):
+    out = tmp_path / "run"
+    killed = mpiexec(2, str(KILLED_RUN), str(out), "after-checkpoint", "6", check=False)
+    assert killed.returncode != 0 and not (out / "results.json").exists(), killed.stderr[-2000:]
+    for ranks, word in ((3, "written on 2 ranks"), (1, "written on 2 ranks")):
+        refused = kalthoff(ranks, out, "--resume", str(out), check=False)
+        lines = [line for line in refused.stderr.splitlines() if "error" in line]
+        assert refused.returncode != 0 and lines and word in lines[0], refused.stderr[-2000:]
+    kalthoff(2, out, "--resume", str(out))
+    assert_same_runs(serial, runs(out))
