@@ -1,10 +1,10 @@
-"""Benchmark: an explicit case under MPI costs about what it costs serially.
+"""Benchmark: a serial explicit case under MPI costs about what it costs serially.
 
-The explicit fracture runs compute on rank 0 (``rkfx.parallel.ranks.on_root``); the other
-ranks must sleep, and each rank gets its share of the cores (``rkfx.parallel.threads``). This
-runs ``kalthoff --quick --method rkpm`` serially with the thread count one of P ranks gets, then
-on P ranks, and fails (exit 1) when the P-rank run takes more than ``--max-ratio`` times as long
-or its results differ.
+The crack-band FEM runs compute on rank 0 (``rkfx.parallel.ranks.on_root``); the other ranks
+must sleep, and each rank gets its share of the cores (``rkfx.parallel.threads``). This runs
+``kalthoff --quick --method fem`` serially with the thread count one of P ranks gets, then on
+P ranks, and fails (exit 1) when the P-rank run takes more than ``--max-ratio`` times as long
+or its results differ. (The RKPM runs are distributed: ``bench/parallel_explicit.py``.)
 
 Usage: python bench/mpi_idle.py [--ranks 2] [--max-ratio 1.5]
 The last line printed reads ``<P> ranks / serial: <ratio>``.
@@ -18,7 +18,7 @@ import tempfile
 import time
 from pathlib import Path
 
-CASE = ["-m", "rkfx.cases.kalthoff", "--quick", "--method", "rkpm"]
+CASE = ["-m", "rkfx.cases.kalthoff", "--quick", "--method", "fem"]
 
 
 def timed(cmd: list[str], env: dict[str, str]) -> float:

@@ -21,6 +21,7 @@ data path (see docs/core.md):
         operators        B^T D B w products: stiffness, diffusion, mass, loads
         boundary         boundary integration, collocated conditions, Nitsche terms
         smeared_strain   the smeared strain of explicit SCNI, lumped mass, stable step (eq. 4.31-4.35)
+        local_strain     one rank's share of the smeared strain: strains at its particles, forces on its nodes
     materials       constitutive laws
         elasticity       the 2-D elastic law (plane strain or stress), principal directions
         damage_law       Mazars' strain and the softening law compiled, shared by statics and dynamics
@@ -32,12 +33,15 @@ data path (see docs/core.md):
         poroelasticity   equal-order u-p Biot model: NI/SCNI with pressure projection (chapter 3)
         damage_bar       the damaging bar under displacement control (chapter 4)
         damage_dynamics  the damage particle method in explicit dynamics, runs kept on disk
+        damage_ranks     the same over MPI ranks: each rank steps its own particles
     solvers         fields, the model protocol, steppers, one Newton, checkpoints
     linalg          linear solves: factorizations through PETSc (``rkfx.linalg.petsc``) or SciPy
     parallel        work over MPI ranks
         partition        recursive coordinate bisection of the nodes into parts
         ownership        a rank's owned nodes and ghosts, the numbering with contiguous parts
         rows             a rank's contributions sent to the owners of their rows
+        halo             ghost copies refreshed by a neighbour-only exchange
+        ghost_counts     the halo of any partition counted serially (for the scaling model)
         ranks            serial work under MPI: rank 0 runs it, the others sleep until they get the result
         threads          numba threads per rank: each rank its share of its node's cores
     conditions      boundary conditions: one vocabulary, values of x and t

@@ -27,3 +27,26 @@ def test_serial_and_parallel_agree(tmp_path, script, ranks):
     a, b = np.load(serial), np.load(parallel)
     assert a.shape == b.shape
     assert np.abs(a - b).max() <= 1e-10 * np.abs(a).max()
+
+
+@pytest.mark.mpi
+@pytest.mark.skipif(not MPIEXEC.exists() and shutil.which("mpiexec") is None, reason="no mpiexec")
+@pytest.mark.parametrize("ranks", [2, 3])
+def test_mandel_quick_on_ranks_is_the_serial_run(tmp_path, ranks):
+    """``mandel --quick`` (RKPM) on 1 rank and on 2 or 3: every series within 1e-10 of its
+    largest value (the early-time overshoots are round-off sized themselves: compared absolutely)."""
+    import json
+
+    mpiexec = str(MPIEXEC) if MPIEXEC.exists() else "mpiexec"
+    args = ["-m", "rkfx.cases.mandel", "--quick", "--method", "rkpm", "--out"]
+    subprocess.run([sys.executable, *args, str(tmp_path / "serial")], check=True, timeout=300, capture_output=True)
+    subprocess.run([mpiexec, "-n", str(ranks), sys.executable, *args, str(tmp_path / "parallel")], check=True,
+                   timeout=300, capture_output=True)
+    serial, parallel = (json.loads((tmp_path / d / "results.json").read_text())["runs"] for d in ("serial", "parallel"))
+    assert [r["method"] for r in serial] == [r["method"] for r in parallel]
+    for a, b in zip(serial, parallel):
+        for key, x in a["series"].items():
+            x, y = np.asarray(x, float), np.asarray(b["series"][key], float)
+            assert np.nanmax(np.abs(x - y)) <= 1e-10 * np.nanmax(np.abs(x)), (a["method"], key)
+        for key, x in a["errors"].items():
+            assert abs(x - b["errors"][key]) <= 1e-10 * max(abs(x), 1e-3), (a["method"], key)

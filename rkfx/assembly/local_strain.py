@@ -49,8 +49,9 @@ class LocalSmearedStrain:
     """A rank's share of a ``SmearedStrain`` (see the module docstring).
 
     Attributes:
-        nodes: Global index of every local node, ascending, shape ``(num_local,)``.
-        owned_nodes: Local index of every owned node, ascending, shape ``(num_owned,)``.
+        nodes: Global index of every local node, shape ``(num_local,)``: the owned nodes first,
+            ascending, then the ghosts by owning rank.
+        owned_nodes: Local index of every owned node, ``arange(num_owned)``.
         points: Global index of every owned point (= owned particle), ascending, ``(num_owned,)``.
         rows: The owned rows over the local nodes (the serial rows' entries in their order).
         ptr: Owned point k has the owned rows ``ptr[k]:ptr[k + 1]``.
@@ -58,9 +59,10 @@ class LocalSmearedStrain:
         volume: V_L of each owned point [m^2].
         rows_t: For each owned node, its entries over the local rows (transposed, row order).
         row_weight: Weight of each local row in the transposed product (1, or V_L without MSCNI).
-        owned_rows: Local index of each owned row among the local rows.
+        owned_rows: Local index of each owned row among the local rows (the first ones).
         node_halo, row_halo: The exchanges of ghost nodes and ghost rows.
         stabilization: The MSCNI terms' owners, or ``None`` (plain SCNI).
+        node_of: Local index of every global node (-1 if not local), shape ``(n,)``.
     """
 
     nodes: np.ndarray
@@ -77,6 +79,7 @@ class LocalSmearedStrain:
     node_halo: Halo
     row_halo: Halo
     stabilization: LocalStabilization | None
+    node_of: np.ndarray
 
     @property
     def num_nodes(self) -> int:
@@ -91,6 +94,11 @@ class LocalSmearedStrain:
     def dofs(self) -> np.ndarray:
         """Global interleaved unknowns of the local nodes, shape ``(2 num_local,)``."""
         return (2 * self.nodes[:, None] + np.arange(2)).ravel()
+
+    def local_dofs(self, dofs: np.ndarray) -> np.ndarray:
+        """Local index of global interleaved unknowns (-1 where not local)."""
+        node = self.node_of[np.asarray(dofs) // 2]
+        return np.where(node >= 0, 2 * node + np.asarray(dofs) % 2, -1)
 
     @property
     def owned_dofs(self) -> np.ndarray:
@@ -116,19 +124,19 @@ class LocalSmearedStrain:
         """f_int on the local nodes, shape ``(2 num_local,)`` [N], from the stresses at the owned
         points (and the MSCNI subcell stresses of the owned rows). Collective."""
         stress = np.ascontiguousarray(stress, dtype=np.float64)
-        load = np.zeros((len(self.row_weight), 3))
+        load = np.empty((len(self.row_weight), 3))
+        mine = load[:len(self.owned_rows)]  # the owned rows come first
         if self.stabilization is None:
-            load[self.owned_rows] = stress
+            mine[...] = stress
         else:
             sub = np.empty((0, 3)) if subcell_stress is None else \
                 np.ascontiguousarray(subcell_stress, dtype=np.float64)
-            tau = np.empty((len(self.owned_rows), 3))
-            subcell_load(self.ptr, self.fraction, self.weight, self.volume, stress, sub, tau)
-            load[self.owned_rows] = tau
+            subcell_load(self.ptr, self.fraction, self.weight, self.volume, stress, sub, mine)
         self.row_halo.exchange(load)
-        f = np.zeros((self.num_local, 2))
-        f[self.owned_nodes] = transposed_force(self.rows_t, load, self.row_weight).reshape(-1, 2)
-        return self.node_halo.exchange(f).ravel()
+        f = np.empty(2 * self.num_local)
+        transposed_force(self.rows_t, load, self.row_weight, out=f[:2 * len(self.owned_nodes)])
+        self.node_halo.exchange(f.reshape(-1, 2))
+        return f
 
 
 def _ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
@@ -138,13 +146,24 @@ def _ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
     return offsets + np.arange(total)
 
 
-def _local(global_ids: np.ndarray, among: np.ndarray) -> np.ndarray:
-    """Positions of ``global_ids`` in the ascending array ``among`` (all present)."""
-    return np.searchsorted(among, global_ids)
+def _numbering(owned: np.ndarray, others: np.ndarray, owner: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
+    """Local order of global entries: ``owned`` first (ascending), then the ghosts ``others`` by
+    owning rank and index (so each neighbour's ghosts are one contiguous block), and the local
+    index of every global entry (-1 for the others), shape ``(size,)``."""
+    ghosts = np.setdiff1d(others, owned)
+    ghosts = ghosts[np.lexsort((ghosts, owner[ghosts]))]
+    order = np.concatenate([owned, ghosts])
+    local_of = np.full(size, -1, np.int64)
+    local_of[order] = np.arange(len(order))
+    return order, local_of
 
 
 def local_smeared_strain(op: SmearedStrain, part: np.ndarray, comm, extra_nodes=()) -> LocalSmearedStrain:
     """The share of ``comm.rank`` of ``op`` for the particle parts ``part`` (collective).
+
+    Local nodes and rows are numbered owned first, then the ghosts by owner; the entries of
+    every row (and of every node's transposed row) keep their serial order, which is what
+    fixes the order of the sums.
 
     Args:
         op: The whole operator (points = particles).
@@ -166,27 +185,27 @@ def local_smeared_strain(op: SmearedStrain, part: np.ndarray, comm, extra_nodes=
     orows = _ranges(ptr[mine], counts)
     entries = _ranges(rows.indptr[orows], np.diff(rows.indptr)[orows])
     cols = rows.indices[entries]
-    nodes = np.union1d(np.union1d(mine, cols), np.asarray(extra_nodes, np.int64))
+    nodes, node_of = _numbering(mine, np.union1d(cols, np.asarray(extra_nodes, np.int64)), part, n)
     indptr = np.zeros(len(orows) + 1, np.int64)
     np.cumsum(np.diff(rows.indptr)[orows], out=indptr[1:])
-    local_rows = SparseRows(indptr, _local(cols, nodes).astype(np.int32), np.ascontiguousarray(rows.data[entries]),
+    local_rows = SparseRows(indptr, node_of[cols].astype(np.int32), np.ascontiguousarray(rows.data[entries]),
                             len(nodes))
     # The rows touching an owned node, through the transposed entries (each node's in row order).
     t_counts = np.diff(rows_t.indptr)[mine]
     t_entries = _ranges(rows_t.indptr[mine], t_counts)
     trows = rows_t.indices[t_entries].astype(np.int64)
-    lrows = np.union1d(orows, trows)
+    lrows, row_of = _numbering(orows, trows, part[row_point], rows.num_rows)
     t_indptr = np.zeros(len(mine) + 1, np.int64)
     np.cumsum(t_counts, out=t_indptr[1:])
-    local_t = SparseRows(t_indptr, _local(trows, lrows).astype(np.int32),
-                         np.ascontiguousarray(rows_t.data[t_entries]), len(lrows))
+    local_t = SparseRows(t_indptr, row_of[trows].astype(np.int32), np.ascontiguousarray(rows_t.data[t_entries]),
+                         len(lrows))
     row_weight = np.ones(len(lrows)) if s is not None else np.ascontiguousarray(op.volume[row_point[lrows]])
     point_ptr = np.zeros(len(mine) + 1, np.int64)
     np.cumsum(counts, out=point_ptr[1:])
     stab = None if s is None else LocalStabilization(np.repeat(np.arange(len(mine)), counts))
     return LocalSmearedStrain(
-        nodes, _local(mine, nodes), mine, local_rows, point_ptr,
+        nodes, np.arange(len(mine)), mine, local_rows, point_ptr,
         None if s is None else np.ascontiguousarray(s.fraction[orows]),
         None if s is None else np.ascontiguousarray(s.weight[orows]),
-        np.ascontiguousarray(op.volume[mine]), local_t, row_weight, _local(orows, lrows),
-        halo(nodes, part[nodes], comm), halo(lrows, part[row_point[lrows]], comm), stab)
+        np.ascontiguousarray(op.volume[mine]), local_t, row_weight, np.arange(len(orows)),
+        halo(nodes, part[nodes], comm), halo(lrows, part[row_point[lrows]], comm), stab, node_of)

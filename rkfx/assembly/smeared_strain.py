@@ -260,10 +260,11 @@ def row_strains(rows: SparseRows, d: np.ndarray) -> np.ndarray:
     return out
 
 
-def transposed_force(rows_t: SparseRows, stress: np.ndarray, weight: np.ndarray) -> np.ndarray:
+def transposed_force(rows_t: SparseRows, stress: np.ndarray, weight: np.ndarray,
+                     out: np.ndarray | None = None) -> np.ndarray:
     """Interleaved force sum_rows grad^T stress weight per column of ``rows_t`` (transposed rows:
-    each node's entries in row order), shape ``(2 num_nodes,)``."""
-    out = np.empty(2 * rows_t.num_rows)
+    each node's entries in row order), shape ``(2 num_nodes,)``, into ``out`` if given."""
+    out = np.empty(2 * rows_t.num_rows) if out is None else out
     _force(rows_t.indptr, rows_t.indices, rows_t.data, np.ascontiguousarray(stress, dtype=np.float64), weight, out)
     return out
 

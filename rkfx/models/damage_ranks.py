@@ -117,7 +117,7 @@ class RankDamage(DamageDynamics):
         self.field = damage_field(self.damage_model, None, dt)
         self.force = RankDamageForce(local, model, self.damage_model, self.field, track, dt, comm)
         self.field.allowed[:] = self.force.allowed[points]
-        essential = [Constraint(_columns(c.G, dofs), c.displacement, c.velocity) for c in constraints]
+        essential = [Constraint(_columns(c.G, local), c.displacement, c.velocity) for c in constraints]
         f_ext = None if external_force is None else (lambda t: np.asarray(external_force(t))[dofs])
         ExplicitDynamics.__init__(self, np.asarray(mass)[dofs], self.force, dt, f_ext, essential,
                                   self.field.arrays | {"allowed_all": self.force.allowed,
@@ -139,10 +139,10 @@ class RankDamage(DamageDynamics):
         return self.gather(owned).ravel()
 
 
-def _columns(g, dofs: np.ndarray):
-    """``g`` on the local unknowns ``dofs`` (ascending, holding every column of ``g``), each row's
-    entries kept in their order, so that G w sums as serially."""
+def _columns(g, local: LocalSmearedStrain):
+    """``g`` on the local unknowns (every column of ``g`` is local), each row's entries kept in
+    their order, so that G w sums as serially."""
     import scipy.sparse as sp  # noqa: PLC0415
 
     g = sp.csr_matrix(g)
-    return sp.csr_matrix((g.data, np.searchsorted(dofs, g.indices), g.indptr), shape=(g.shape[0], len(dofs)))
+    return sp.csr_matrix((g.data, local.local_dofs(g.indices), g.indptr), shape=(g.shape[0], 2 * local.num_local))
