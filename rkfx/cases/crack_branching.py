@@ -46,9 +46,12 @@ energy). A summary run per study maps h to branches and final dissipation
 and gives ``dissipation_change_fine``, |W_d(finest) - W_d(second finest)| / W_d(finest).
 
 Parameters (``--set NAME=VALUE``, SI units): E, nu, rho, ft, GF, sigma, plane, t_end, tol, h,
-unregularized_h, fem_h, support_factor, courant, radius, forward, eps_p. Long runs: ``--checkpoint-every N`` writes
-each model's state every N steps to OUT/checkpoints/, and ``--resume DIR`` continues an
-interrupted invocation (finished models are read back).
+unregularized_h, fem_h, support_factor, courant, radius, forward, eps_p. Long runs:
+``--checkpoint-every N`` writes each model's state every N steps to OUT/checkpoints/, and
+``--resume DIR`` continues an interrupted invocation (finished models are read back). A resume
+with other parameters is refused in one line (``--recompute`` computes the runs again). Under
+``mpiexec`` the RKPM models are distributed over the ranks (``rkfx.models.damage_ranks``: the
+serial damage bit for bit); the crack-band FEM models run on rank 0.
 
     python -m rkfx.cases.crack_branching [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
 """

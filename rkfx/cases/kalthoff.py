@@ -48,8 +48,11 @@ run per study maps node counts to angles and final dissipation and gives their s
 Parameters (``--set NAME=VALUE``, SI units): E, nu, rho, ft, GF, v0, t_end, tol, nodes,
 unregularized_nodes, no_tracking_nodes, fem_nodes, support_factor, courant, radius, forward, eps_p,
 angle_radius. Long runs: ``--checkpoint-every N`` writes each model's state every N steps to
-OUT/checkpoints/, and ``--resume DIR`` continues an interrupted invocation (finished models
-are read back).
+OUT/checkpoints/, and ``--resume DIR`` continues an interrupted invocation (finished models are
+read back). A resume with other parameters is refused in one line (``--recompute`` computes the
+runs again). Under ``mpiexec`` the RKPM models are distributed over the ranks
+(``rkfx.models.damage_ranks``: the serial damage bit for bit); the crack-band FEM models run on
+rank 0.
 
     python -m rkfx.cases.kalthoff [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
 """
