@@ -366,27 +366,23 @@ def check_resume(resume: Path, stamp: Mapping[str, Any], recompute: bool) -> boo
     ``False`` with ``recompute``, else a one-line error naming the differing parameters."""
     folder = Path(resume) / "checkpoints"
     path = folder / FINGERPRINT
-    stored_runs = [d for d in folder.iterdir() if d.is_dir()] if folder.is_dir() else []
+    why, fix = None, "add --recompute to compute them again"
     if path.is_file():
         try:
             diff = differences(json.loads(path.read_text()), stamp)
         except (ValueError, AttributeError):
             diff = [f"{path} is unreadable"]
-    elif stored_runs:
-        if recompute:
-            logging.getLogger("rkfx").info("resume: %s has no %s; computing every run again", folder, FINGERPRINT)
-            return False
-        raise ParameterError(f"--resume {resume}: {folder} has no {FINGERPRINT} (written by an older rkfx), so its "
-                             "runs cannot be checked against these parameters; add --recompute to compute them again")
-    else:
-        diff = []
-    if not diff:
+        if diff:
+            why, fix = f"its runs were computed with {'; '.join(diff)}", "resume with the same --set values, or " + fix
+    elif folder.is_dir() and any(d.is_dir() for d in folder.iterdir()):
+        why = (f"{folder} has no {FINGERPRINT} (written by an older rkfx), so its runs cannot be checked against "
+               "these parameters")
+    if why is None:
         return True
     if recompute:
-        logging.getLogger("rkfx").info("resume: %s differs: %s; computing every run again", resume, "; ".join(diff))
+        logging.getLogger("rkfx").info("resume: %s: %s; computing every run again", resume, why)
         return False
-    raise ParameterError(f"--resume {resume}: its runs were computed with {'; '.join(diff)}; resume with the same "
-                         "--set values, or add --recompute to compute them again")
+    raise ParameterError(f"--resume {resume}: {why}; {fix}")
 
 
 def write_fingerprint(folder: Path, stamp: Mapping[str, Any]) -> list[Path]:

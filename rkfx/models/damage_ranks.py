@@ -39,14 +39,18 @@ class MpiShare:
         self.rank, self.size = comm.rank, comm.size
 
     def sum(self, values: np.ndarray) -> np.ndarray:
-        from mpi4py import MPI  # noqa: PLC0415 - loaded already: the communicator is one
-
-        out = np.ascontiguousarray(values, dtype=np.float64).copy()
-        self.comm.Allreduce(MPI.IN_PLACE, out, op=MPI.SUM)
-        return out
+        return _summed(self.comm, np.array(values, dtype=np.float64))
 
     def least(self, value: int) -> int:
         return int(min(self.comm.allgather(int(value))))
+
+
+def _summed(comm, values: np.ndarray) -> np.ndarray:
+    """``values`` (C-contiguous) summed over the ranks, in place; returns them."""
+    from mpi4py import MPI  # noqa: PLC0415 - loaded already: the communicator is one
+
+    comm.Allreduce(MPI.IN_PLACE, values, op=MPI.SUM)
+    return values
 
 
 def restricted(model: DamageModel, points: np.ndarray) -> DamageModel:
@@ -73,11 +77,8 @@ class RankDamageForce(DamageForce):
 
     def _anywhere(self, count: int) -> bool:
         """Whether any rank has initiations in this evaluation (an all-reduce of one number)."""
-        from mpi4py import MPI  # noqa: PLC0415 - loaded already: the communicator is one
-
         self._count[0] = count
-        self.comm.Allreduce(MPI.IN_PLACE, self._count, op=MPI.SUM)
-        return bool(self._count[0])
+        return bool(_summed(self.comm, self._count)[0])
 
     def _initiate_all(self, new: np.ndarray) -> None:
         f, points = self.field, self.op.points
@@ -94,8 +95,10 @@ class RankDamageForce(DamageForce):
         fresh = ~self.allowed[cand]
         self.parent[cand[fresh]] = by[fresh]
         self.allowed[cand] = True
-        f.allowed[:] = self.allowed[points]
-        f.parent[:] = self.parent[points]
+        local = self.op.node_of[cand]  # points are the owned particles, the first local nodes
+        mine = (local >= 0) & (local < len(points))
+        f.allowed[local[mine]] = True
+        f.parent[local[mine]] = self.parent[cand[mine]]
 
 
 class RankDamage(DamageDynamics):

@@ -38,12 +38,18 @@ def rank_folder(directory: str | Path, rank: int, size: int) -> Path:
     return Path(directory) / f"rank{rank}-of-{size}"
 
 
+def _ranks_of(folder: Path) -> int | None:
+    """P of a ``rank<r>-of-<P>`` folder, else ``None``."""
+    head, sep, size = folder.name.rpartition("-of-")
+    return int(size) if sep and head.startswith("rank") and size.isdigit() else None
+
+
 def _written_on(directory: Path) -> int | None:
     """On how many ranks the checkpoints in ``directory`` (a run's folder) were written, if any."""
     if any((directory / n).is_file() for n in (CHECKPOINT, PREVIOUS)):
         return 1
-    sizes = {int(d.name.rsplit("-of-", 1)[1]) for d in directory.glob("rank*-of-*") if d.is_dir()
-             and d.name.rsplit("-of-", 1)[1].isdigit() and has_checkpoint(d)} if directory.is_dir() else set()
+    sizes = {_ranks_of(d) for d in directory.glob("rank*-of-*") if d.is_dir() and has_checkpoint(d)} - {None} \
+        if directory.is_dir() else set()
     return min(sizes) if sizes else None
 
 
@@ -157,9 +163,9 @@ def load_arrays(directory: str | Path, common: Callable[[int], int] | None = Non
 def _load_newest(directory: Path) -> dict[str, np.ndarray]:
     newest, previous = directory / CHECKPOINT, directory / PREVIOUS
     if not (newest.is_file() or previous.is_file()):
-        per_rank = "-of-" in directory.name and directory.name.startswith("rank")
-        run = directory.parent if per_rank else directory
-        now = int(directory.name.rsplit("-of-", 1)[1]) if per_rank else 1
+        now = _ranks_of(directory)
+        run = directory if now is None else directory.parent
+        now = now or 1
         ranks = _written_on(run)
         if ranks is not None and ranks != now:
             how = f"on {ranks} ranks" if ranks > 1 else "serially"
