@@ -30,9 +30,10 @@ from verification.manufactured import SineField
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--nodes", type=int, default=300, help="nodes per side")
+    ap.add_argument("--solver", default="mumps", help="mumps | gmres-ilu | cg-gamg")
     ap.add_argument("--save", help="write the coefficients (rank 0) to this .npy file")
     ap.add_argument("--compare", help="report the relative difference to these saved coefficients")
-    args = ap.parse_args()
+    args, _petsc_options = ap.parse_known_args()  # the rest: PETSc options (-rkfx_...)
     comm = MPI.COMM_WORLD
     warm_up()
     p = structured(1.0, 1.0, args.nodes, args.nodes)
@@ -41,7 +42,8 @@ def main() -> None:
     bcs = [Displacement(side, lambda x, t: field.displacement(x)) for side in p.boundary_names]
     comm.Barrier()
     t0 = time.perf_counter()
-    sol = solve_plane_strain(p, material, bcs, body_force=field.body_force, rule="mscni", comm=comm)
+    sol = solve_plane_strain(p, material, bcs, body_force=field.body_force, rule="mscni", comm=comm,
+                             solver=args.solver)
     wall = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
     stages = {k: comm.allreduce(v, op=MPI.MAX) for k, v in sol.timings.items()}
     rss = comm.gather(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, root=0)

@@ -31,6 +31,18 @@ def test_serial_and_parallel_agree(tmp_path, script, ranks):
 
 @pytest.mark.mpi
 @pytest.mark.skipif(not MPIEXEC.exists() and shutil.which("mpiexec") is None, reason="no mpiexec")
+@pytest.mark.parametrize("ranks", [1, 2, 3])
+def test_contributions_assemble_at_their_owners(ranks):
+    """``UnknownShare.assemble`` and ``row_system`` give the whole vector and matrix rows."""
+    script = Path(__file__).parent / "mpi" / "assemble_by_owners.py"
+    mpiexec = str(MPIEXEC) if MPIEXEC.exists() else "mpiexec"
+    done = subprocess.run([mpiexec, "-n", str(ranks), sys.executable, str(script)], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0 and "ok" in done.stdout, done.stderr[-2000:]
+
+
+@pytest.mark.mpi
+@pytest.mark.skipif(not MPIEXEC.exists() and shutil.which("mpiexec") is None, reason="no mpiexec")
 @pytest.mark.parametrize("ranks", [2, 3])
 def test_mandel_quick_on_ranks_is_the_serial_run(tmp_path, ranks):
     """``mandel --quick`` (RKPM) on 1 rank and on 2 or 3: every series within 1e-10 of its
@@ -50,3 +62,37 @@ def test_mandel_quick_on_ranks_is_the_serial_run(tmp_path, ranks):
             assert np.nanmax(np.abs(x - y)) <= 1e-10 * np.nanmax(np.abs(x)), (a["method"], key)
         for key, x in a["errors"].items():
             assert abs(x - b["errors"][key]) <= 1e-10 * max(abs(x), 1e-3), (a["method"], key)
+
+
+@pytest.mark.mpi
+@pytest.mark.skipif(not MPIEXEC.exists() and shutil.which("mpiexec") is None, reason="no mpiexec")
+def test_mandel_killed_on_two_ranks_resumes_on_two_ranks(tmp_path):
+    """The u-p runs are distributed (each rank steps its own unknowns, one checkpoint per rank):
+    killed on 2 ranks after a checkpoint, refused on 3, resumed on 2 to the serial results."""
+    import json
+    import os
+
+    root = Path(__file__).resolve().parents[1]
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")]))
+    mpiexec = str(MPIEXEC) if MPIEXEC.exists() else "mpiexec"
+    args = ["-m", "rkfx.cases.mandel", "--quick", "--method", "rkpm", "--checkpoint-every", "4"]
+    out = tmp_path / "run"
+    subprocess.run([sys.executable, *args, "--out", str(tmp_path / "serial")], check=True, timeout=300,
+                   capture_output=True, env=env)
+    killed = subprocess.run([mpiexec, "-n", "2", sys.executable, str(root / "tests" / "faults" / "killed_run.py"),
+                             str(out), "after-checkpoint", "3", "mandel"], timeout=300, capture_output=True, env=env)
+    assert killed.returncode != 0 and not (out / "results.json").exists()
+    run = out / "checkpoints" / "rkpm-scni+fpp-profiles"
+    assert sorted(p.name for p in run.iterdir() if p.is_dir()) == ["rank0-of-2", "rank1-of-2"]
+    refused = subprocess.run([mpiexec, "-n", "3", sys.executable, *args, "--out", str(out), "--resume", str(out)],
+                             timeout=300, capture_output=True, text=True, env=env)
+    errors = [line for line in refused.stderr.splitlines() if "error" in line]
+    assert refused.returncode != 0 and errors and "written on 2 ranks" in errors[0], refused.stderr[-2000:]
+    resumed = subprocess.run([mpiexec, "-n", "2", sys.executable, *args, "--out", str(out), "--resume", str(out)],
+                             timeout=300, capture_output=True, text=True, env=env, check=True)
+    assert "continues from step 12" in resumed.stderr
+    serial, parallel = (json.loads((d / "results.json").read_text())["runs"] for d in (tmp_path / "serial", out))
+    for a, b in zip(serial, parallel, strict=True):
+        for key, x in a["series"].items():
+            x, y = np.asarray(x, float), np.asarray(b["series"][key], float)
+            assert np.nanmax(np.abs(x - y)) <= 1e-10 * np.nanmax(np.abs(x)), (a["method"], key)

@@ -139,7 +139,8 @@ def _conditions(exact):
 def _rkpm(p, material, bcs, times, outputs, variant, support_factor, desc, io):
     kinds = split(bcs)
     sol = solve_biot(p, material, times, outputs, kinds[Displacement], kinds[Pressure], variant=variant,
-                     support_factor=support_factor, progress=lambda it: _cli.progress(it, desc, len(times) - 1), **io)
+                     support_factor=support_factor, comm=_cli.comm(),
+                     progress=lambda it: _cli.progress(it, desc, len(times) - 1), **io)
     return sol, sol.pressure, sol.wall_time_s, sol.n_dofs
 
 

@@ -162,7 +162,7 @@ def _solve(method, xs, ys, material, q, b, times, outputs, samples, drained, sup
         kinds = split(held)
         sol = solve_biot(p, material, times, outputs, displacements=kinds[Displacement], pressures=kinds[Pressure],
                          tractions=[load], variant=method[5:], support_factor=support_factor,
-                         progress=lambda it: _cli.progress(it, method, len(times) - 1), **io)
+                         comm=_cli.comm(), progress=lambda it: _cli.progress(it, method, len(times) - 1), **io)
         return sol.pressure(samples), sol.displacement(samples), sol.wall_time_s, sol.n_dofs
     import dolfinx_solver  # noqa: F401, PLC0415
 

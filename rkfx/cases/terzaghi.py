@@ -148,7 +148,7 @@ def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_f
         kinds = split(bcs)
         sol = solve_biot(p, material, times, outputs, displacements=kinds[Displacement], pressures=kinds[Pressure],
                          tractions=kinds[Traction], variant=method[5:], support_factor=support_factor,
-                         progress=lambda it: _cli.progress(it, method, len(times) - 1), **io)
+                         comm=_cli.comm(), progress=lambda it: _cli.progress(it, method, len(times) - 1), **io)
         return sol.pressure(samples), sol.wall_time_s, sol.n_dofs
     import dolfinx_solver  # noqa: F401, PLC0415
 

@@ -67,10 +67,12 @@ def gauss(p: Particles, rk: RKApproximation, degree: int = 2) -> Quadrature:
                       SparseRows(rows.indptr, rows.indices, rows.data[:, 1:], rows.num_cols), f"gauss{degree}")
 
 
-def dni(p: Particles, rk: RKApproximation, domains: NodalDomains) -> Quadrature:
-    """Direct nodal integration: N and its direct gradient at the nodes, weights A_L."""
-    rows = evaluate(rk, p.x, gradients=True)
-    return Quadrature(p.x, domains.area, rows.component(0),
+def dni(p: Particles, rk: RKApproximation, domains: NodalDomains, nodes: np.ndarray | None = None) -> Quadrature:
+    """Direct nodal integration: N and its direct gradient at the nodes (or at ``nodes`` only),
+    weights A_L."""
+    x, area = (p.x, domains.area) if nodes is None else (p.x[nodes], domains.area[nodes])
+    rows = evaluate(rk, x, gradients=True)
+    return Quadrature(x, area, rows.component(0),
                       SparseRows(rows.indptr, rows.indices, rows.data[:, 1:], rows.num_cols), "dni")
 
 

@@ -4,7 +4,9 @@ The core stays importable without PETSc; with ``rkfx[fem]`` installed every solv
 ``rkfx.linalg.petsc`` (MUMPS LU by default, distributed over the communicator's ranks).
 ``solver="serial"`` factorizes a small system that every rank holds whole (the projection onto
 the essential conditions, k x k for k constrained values) by SuperLU on each rank, with no
-communication in its solves.
+communication in its solves. A ``rkfx.parallel.unknowns.RowSystem`` (a rank's block of rows of
+a distributed system) is solved on local vectors: its owned entries go to PETSc, and the
+solution comes back with the ghost entries filled by their owners.
 """
 from collections.abc import Mapping
 
@@ -39,6 +41,26 @@ class _ScipyLU:
         pass
 
 
+class _RowSystemSolver:
+    """A distributed system given by each rank's ``RowSystem``, solved on local vectors."""
+
+    def __init__(self, system, comm, solver: str, mumps_icntl):
+        from rkfx.linalg import petsc  # noqa: PLC0415 - a distributed system needs PETSc
+
+        self.system = system
+        self._ls = petsc.LinearSolver(system.block, comm, solver, mumps_icntl, owned_rows=True)
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        x = self._ls.solve(self.system.owned_values(b), whole=False)
+        return self.system.local_values(x)
+
+    def matches(self, a) -> bool:
+        return False
+
+    def destroy(self) -> None:
+        self._ls.destroy()
+
+
 def linear_solver(a: sp.spmatrix, comm=None, solver: str = "mumps", mumps_icntl: Mapping[int, int] | None = None,
                   owned_rows: bool = False):
     """An object with ``.solve(b)`` and ``.destroy()`` for the matrix ``a`` (``mumps_icntl``:
@@ -48,6 +70,13 @@ def linear_solver(a: sp.spmatrix, comm=None, solver: str = "mumps", mumps_icntl:
     (``rkfx.parallel.rows.owned_block``); ``solve`` still returns the whole solution."""
     if solver == "serial":
         return _ScipyLU(a)
+    from rkfx.parallel.unknowns import RowSystem  # noqa: PLC0415
+
+    if isinstance(a, RowSystem):
+        try:
+            return _RowSystemSolver(a, comm if comm is not None else a.share.comm, solver, mumps_icntl)
+        except ImportError:
+            raise InputError("a system distributed over MPI ranks needs PETSc: pip install 'rkfx[fem]'") from None
     try:
         from rkfx.linalg import petsc  # noqa: PLC0415
     except ImportError:

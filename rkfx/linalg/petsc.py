@@ -153,9 +153,10 @@ class LinearSolver:
         self._norm = self.mat.norm(PETSc.NormType.NORM_INFINITY)
         self._warned = False
 
-    def solve(self, b: np.ndarray) -> np.ndarray:
+    def solve(self, b: np.ndarray, whole: bool = True) -> np.ndarray:
         """The whole solution on every rank (``b``: the whole right-hand side, or this rank's
-        entries of it when the solver was built from owned rows)."""
+        entries of it when the solver was built from owned rows); ``whole=False``: this
+        rank's entries of it only."""
         lo, hi = self.rhs.getOwnershipRange()
         b = np.asarray(b, dtype=PETSc.ScalarType)
         self.rhs.array[:] = b if self.owned_rows else b[lo:hi]
@@ -187,7 +188,7 @@ class LinearSolver:
             warnings.warn(f"system matrix has {null_pivots} null pivot(s) (nearly singular); the solution "
                           "satisfies the equations but is not unique in those modes", RuntimeWarning, stacklevel=2)
             self._warned = True
-        return gather(self.x)
+        return gather(self.x) if whole else self.x.array_r.copy()
 
     def matches(self, a: sp.spmatrix) -> bool:
         """Whether ``a`` has this system's sparsity pattern (so ``refactor`` may take it)."""

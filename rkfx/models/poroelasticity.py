@@ -44,6 +44,9 @@ from rkfx.assembly.operators import laplacian, mass, stiffness
 from rkfx.geometry.particles import Particles
 from rkfx.integration.quadrature import Quadrature, dni, mscni_stabilization, scni, smoothed_gradients
 from rkfx.approximation.shape_functions import RKApproximation, evaluate, rk_approximation
+from rkfx.parallel.ownership import numbering
+from rkfx.parallel.partition import rcb
+from rkfx.parallel.unknowns import LocalUnknowns, local_unknowns, touched_nodes
 from rkfx.solvers.fields import layout
 from rkfx.solvers.integrate import integrate
 from rkfx.solvers.model import Constraints, PerStepSize, Stateless
@@ -188,7 +191,8 @@ class NodalFields:
 
 
 def biot_operators(p: Particles, rk: RKApproximation, domains: NodalDomains, material: PoroMaterial,
-                   variant: str = "scni+fpp", eps_p: float = 1.0, fields: NodalFields | None = None) -> BiotOperators:
+                   variant: str = "scni+fpp", eps_p: float = 1.0, fields: NodalFields | None = None,
+                   nodes: np.ndarray | None = None) -> BiotOperators:
     """Assemble the u-p operators of one integration variant.
 
     Args:
@@ -197,6 +201,8 @@ def biot_operators(p: Particles, rk: RKApproximation, domains: NodalDomains, mat
         variant: ``ni``, ``scni``, ``ni+fpp`` or ``scni+fpp``.
         eps_p: MSCNI stabilization factor of the subcell terms (3.56).
         fields: Per-particle material fields overriding the constants.
+        nodes: Integrate over the nodal domains of these nodes only (indices, ascending: a
+            rank's own nodes); the operators of a partition's parts sum to the whole ones.
     """
     if variant not in VARIANTS:
         raise InputError(f"unknown variant {variant!r}; choose one of {', '.join(VARIANTS)}")
@@ -204,44 +210,50 @@ def biot_operators(p: Particles, rk: RKApproximation, domains: NodalDomains, mat
     n = p.num_nodes
     fields = NodalFields() if fields is None else fields
     fields.check(n)
+    mine = np.arange(n) if nodes is None else np.asarray(nodes, np.int64)
     stabilized = variant.startswith("scni")
     if stabilized:
-        smoothed = smoothed_gradients(p, rk, d, subcells=True)
+        smoothed = smoothed_gradients(p, rk, d, subcells=True, nodes=nodes)
         nodal = scni(p, rk, d, smoothed)
         stab = mscni_stabilization(p, rk, d, smoothed, eps_p, with_values=True)
-        quads, owners = [nodal, stab], [np.arange(n), d.subcell_node]
+        subcells = smoothed.subcells
+        quads, owners = [nodal, stab], [mine, d.subcell_node[subcells]]
     else:
-        nodal = dni(p, rk, d)
-        quads, owners = [nodal], [np.arange(n)]
+        nodal = dni(p, rk, d, nodes=nodes)
+        subcells = np.flatnonzero(np.isin(d.subcell_node, mine)) if nodes is not None else None
+        quads, owners = [nodal], [mine]
 
     def at_points(value, constant):
         return constant if value is None else [np.asarray(value, float)[o] for o in owners]
 
     kuu = stiffness(quads, at_points(fields.D, material.elastic.D()))
     # Coupling (3.57): nodal points only.
-    alpha = material.alpha if fields.alpha is None else np.asarray(fields.alpha, float)
+    alpha = material.alpha if fields.alpha is None else np.asarray(fields.alpha, float)[mine]
     kup = (divergence_matrix(nodal).T @ sp.diags(alpha * nodal.weights) @ nodal.values.matrix()).tocsr()
     ks = mass(quads, at_points(fields.S, material.S)) if (material.S > 0 or fields.S is not None) \
         else sp.csr_matrix((n, n))
     kh = laplacian(quads, at_points(fields.k, material.k))
-    rows, weights, nodes = [], [], []
+    rows, weights, row_nodes = [], [], []
     if variant.endswith("+fpp"):
         # (3.61): Pi N(x_L) = sum_C N(x_hat_C) A_C / A_L, so the cell rows are N(x_L) - Pi N(x_L).
-        at_centroids = evaluate(rk, d.subcell_centroid)
-        order = np.argsort(d.subcell_node, kind="stable")
-        ptr = np.r_[0, np.cumsum(np.bincount(d.subcell_node, minlength=n))]
+        sub = np.arange(len(d.subcell_node)) if subcells is None else subcells
+        owner = d.subcell_node[sub]
+        at_centroids = evaluate(rk, d.subcell_centroid[sub])
+        order = np.argsort(owner, kind="stable")
+        counts = np.bincount(owner, minlength=n)[mine]
+        ptr = np.r_[0, np.cumsum(counts)]
         cell_rows = combine_rows(at_centroids, ptr, order,
-                                 -(d.subcell_area / d.area[d.subcell_node])[order],
-                                 base=nodal.values, base_row=np.arange(n))
+                                 -(d.subcell_area[sub] / d.area[owner])[order],
+                                 base=nodal.values, base_row=np.arange(len(mine)))
         rows.append(cell_rows)
-        weights.append(d.area)
-        nodes.append(np.arange(n))
+        weights.append(d.area[mine])
+        row_nodes.append(mine)
         if stabilized:
             # (3.62): Pi N(x_hat_C) = N(x_hat_C): the subcell rows are the MSCNI value rows.
             rows.append(stab.values)
             weights.append(stab.weights)
-            nodes.append(d.subcell_node)
-    return BiotOperators(kuu, kup, ks, kh, rows, weights, nodes, np.sqrt(d.area))
+            row_nodes.append(owner)
+    return BiotOperators(kuu, kup, ks, kh, rows, weights, row_nodes, np.sqrt(d.area))
 
 
 # Boundary conditions: the core's vocabulary (``rkfx.conditions``); a traction of the u-p
@@ -294,19 +306,28 @@ class BiotModel(Stateless):
         collocation: Collocated essential conditions of u and p.
         nodes: Node coordinates at which the conditions are collocated, shape ``(n, 2)`` [m].
         loads: F^ext(t), Q^ext(t) as ``(2 n,)`` and ``(n,)`` arrays.
+        local: On MPI ranks, the rank's local unknowns (``rkfx.parallel.unknowns``): the
+            operators, loads and collocation rows are then the rank's own contributions, and the
+            model lives on the local nodes (``share`` tells the steppers); ``None``: the whole model.
     """
 
     def __init__(self, operators: BiotOperators, material: PoroMaterial, col: Collocation,
-                 nodes: np.ndarray, loads: Callable[[float], tuple[np.ndarray, np.ndarray]]):
-        n = operators.Kh.shape[0]
+                 nodes: np.ndarray, loads: Callable[[float], tuple[np.ndarray, np.ndarray]],
+                 local: LocalUnknowns | None = None):
+        self.operators, self.material, self.collocation, self.loads = operators, material, col, loads
+        self.nodes, self.local = nodes, local
+        self.share = None if local is None else local.share
+        n = operators.Kh.shape[0] if local is None else len(local.nodes)
         self.layout = layout(("u", 2, 1), ("p", 1, 1), nodes=n)
         self.linear = True
-        self.operators, self.material, self.collocation, self.loads = operators, material, col, loads
-        self.nodes = nodes
         o = operators
-        self._K = sp.bmat([[o.Kuu, -o.Kup], [None, o.Kh]], format="csr")
+        self._K = self._local(sp.bmat([[o.Kuu, -o.Kup], [None, o.Kh]], format="csr"))
+        self._G = col.G if local is None else col.G[:, local.index].tocsr()
         self._per_step = PerStepSize(keep=5)
         self._n = n
+
+    def _local(self, a: sp.csr_matrix) -> sp.csr_matrix:
+        return a if self.local is None else self.local.matrix(a)
 
     def storage(self, dt: float) -> sp.csr_matrix:
         """Compressibility plus the projection stabilization (3.60) for steps of dt, ``(n, n)``."""
@@ -315,7 +336,8 @@ class BiotModel(Stateless):
 
     def residual(self, x: np.ndarray, t: float) -> np.ndarray:
         f, q = self.loads(t)
-        return self._K @ x - np.concatenate([f, q])
+        fq = np.concatenate([f, q])
+        return self._K @ x - (fq if self.local is None else self.local.vector(fq))
 
     def tangent(self, x: np.ndarray, t: float) -> sp.csr_matrix:
         return self._K
@@ -324,12 +346,12 @@ class BiotModel(Stateless):
         return None
 
     def capacity(self, dt: float) -> sp.csr_matrix:
-        n = self._n
-        return self._per_step.get("capacity", dt, lambda dt: sp.bmat(
-            [[sp.csr_matrix((2 * n, 2 * n)), None], [self.operators.Kup.T, self.storage(dt)]], format="csr"))
+        n = self.operators.Kh.shape[0]
+        return self._per_step.get("capacity", dt, lambda dt: self._local(sp.bmat(
+            [[sp.csr_matrix((2 * n, 2 * n)), None], [self.operators.Kup.T, self.storage(dt)]], format="csr")))
 
     def constraints(self, t: float) -> Constraints:
-        return Constraints(self.collocation.G, self.collocation.values(self.nodes, t))
+        return Constraints(self._G, self.collocation.values(self.nodes, t))
 
     def equation_weights(self, co) -> np.ndarray:
         """-1 / (du'/du) on the storage rows: the symmetric saddle-point Jacobian
@@ -339,10 +361,11 @@ class BiotModel(Stateless):
 
 
 class _Outputs:
-    """Nodal coefficients kept at the output times."""
+    """Nodal coefficients kept at the output times (on MPI ranks, each rank those of its own
+    nodes; ``whole`` sums them over the ranks)."""
 
-    def __init__(self, wanted: np.ndarray, n: int):
-        self.wanted = wanted
+    def __init__(self, wanted: np.ndarray, n: int, local: LocalUnknowns | None = None):
+        self.wanted, self.local = wanted, local
         self.U = np.zeros((len(wanted), n, 2))
         self.P = np.zeros((len(wanted), n))
         self.n = n
@@ -350,8 +373,21 @@ class _Outputs:
     def record(self, s) -> None:
         j = np.flatnonzero(np.abs(self.wanted - s.t) <= 1e-12 * np.maximum(self.wanted, 1.0))
         for i in j:
-            self.U[i] = s.x[:2 * self.n].reshape(self.n, 2)
-            self.P[i] = s.x[2 * self.n:]
+            if self.local is None:
+                self.U[i] = s.x[:2 * self.n].reshape(self.n, 2)
+                self.P[i] = s.x[2 * self.n:]
+            else:
+                loc, own = self.local, self.local.num_owned_nodes
+                m = len(loc.nodes)
+                self.U[i][loc.nodes[:own]] = s.x[:2 * m].reshape(m, 2)[:own]
+                self.P[i][loc.nodes[:own]] = s.x[2 * m:2 * m + own]
+
+    def whole(self) -> tuple[np.ndarray, np.ndarray]:
+        """U and P of every node (a sum over the ranks of their own nodes' values)."""
+        if self.local is None:
+            return self.U, self.P
+        comm = self.local.share.comm
+        return comm.allreduce(self.U), comm.allreduce(self.P)  # exact: one rank holds each node
 
     def arrays(self) -> dict[str, np.ndarray]:
         return {"U": self.U, "P": self.P}
@@ -369,7 +405,7 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
                comm=None, solver: str = "mumps", progress: Callable | None = None,
                rk: RKApproximation | None = None, domains: NodalDomains | None = None,
                fields: NodalFields | None = None, checkpoint_every: int = 0, checkpoint_dir=None,
-               resume=None) -> BiotSolution:
+               resume=None, distributed: bool | None = None) -> BiotSolution:
     """Solve the u-p equations by backward Euler on the step times ``times`` (t_0 = 0).
 
     Initial state u = 0, p = 0. Loads and prescribed values are evaluated at t_{n+1} (3.39)-(3.40).
@@ -396,6 +432,11 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
             storage) in place of the material's constants.
         checkpoint_every, checkpoint_dir: Write a checkpoint every so many steps.
         resume: A checkpoint folder to continue from (same particles, material and times).
+        distributed: Split the particles over the ranks of ``comm`` (RCB): each rank
+            integrates over its own nodes' domains and steps its local unknowns, the system is
+            assembled by owned rows (``rkfx.parallel.unknowns``), and the checkpoints are one
+            per rank. ``None`` (default): when ``comm`` has more than one rank. The solution is
+            gathered on every rank at the end.
     """
     t_all = np.asarray(times, float)
     if t_all[0] != 0.0 or np.any(np.diff(t_all) <= 0):
@@ -407,20 +448,29 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
         raise InputError("every output time must be one of the step times (use rkfx.solvers.integrate.time_grid)")
     if not (displacements or pressures):
         raise InputError("no essential boundary conditions: prescribe displacements (and pressures)")
+    if distributed is None:
+        distributed = comm is not None and comm.size > 1
+    elif distributed and comm is None:
+        raise InputError("distributed=True needs comm, the MPI communicator to split the particles over")
     timings = {}
     t0 = time.perf_counter()
     rk = rk_approximation(p.x, p.spacing, support_factor) if rk is None else rk
     d = nodal_domains(p) if domains is None else domains
-    ops = biot_operators(p, rk, d, material, variant, fields=fields)
-    bq = boundary_quadrature(p, d, rk)
-    col = collocation(p, rk, [(displacements, 0, 2), (pressures, 2 * p.num_nodes, 1)], 3 * p.num_nodes)
-    nb = bq.rows.matrix(0)
     n = p.num_nodes
+    num = mine = segments = None
+    if distributed:
+        num = numbering(rcb(p.x, comm.size), comm.size)
+        mine = num.old_of_new[num.ranges[comm.rank]:num.ranges[comm.rank + 1]]
+        segments = np.flatnonzero(np.isin(d.boundary.node, mine))
+    ops = biot_operators(p, rk, d, material, variant, fields=fields, nodes=mine)
+    bq = boundary_quadrature(p, d, rk, segments=segments)
+    col = collocation(p, rk, [(displacements, 0, 2), (pressures, 2 * n, 1)], 3 * n, nodes=mine)
+    nb = bq.rows.matrix(0)
     # Gravity (3.36)-(3.37), integrated at the nodes like the other nodal terms.
     f_gravity, q_gravity = np.zeros(2 * n), np.zeros(n)
     if gravity is not None:
         g = np.asarray(gravity, float).reshape(2)
-        nodal = dni(p, rk, d) if not variant.startswith("scni") else scni(p, rk, d)
+        nodal = dni(p, rk, d, nodes=mine) if not variant.startswith("scni") else scni(p, rk, d, nodes=mine)
         w = nodal.weights
         f_gravity = (nodal.values.matrix().T @ (w[:, None] * density * g)).ravel()
         grad = nodal.gradients
@@ -440,10 +490,18 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
             q -= nb[sel].T @ (bq.weights[sel] * values(fl, bq.points[sel], t, bq.normals[sel])[:, 0])
         return f.ravel() + f_gravity, q + q_gravity  # F^ext (3.36) and Q^ext (3.37)
 
-    model = BiotModel(ops, material, col, p.x, loads)
-    kept = _Outputs(wanted, n)
+    local = None
+    if distributed:
+        # The nodes this rank's terms touch: its own and the ghosts (stiffness, coupling,
+        # storage with the projection pattern, collocation rows, boundary loads).
+        whole = sp.bmat([[ops.Kuu, -ops.Kup], [ops.Kup.T, ops.Ks + ops.stabilization(np.ones(n))]], format="csr")
+        touched = touched_nodes((2, 1), n, whole, col.G)
+        local = local_unknowns(num, np.unique(np.r_[touched, nb.indices, mine]), (2, 1), comm)
+    model = BiotModel(ops, material, col, p.x, loads, local)
+    kept = _Outputs(wanted, n, local)
     integrate(backward_euler(), model, t_all, recorder=kept, comm=comm, solver=solver,
                     progress=progress, max_cuts=0, checkpoint_every=checkpoint_every,
                     checkpoint_dir=checkpoint_dir, resume=resume)
     timings["steps"] = time.perf_counter() - t0
-    return BiotSolution(rk, wanted, kept.U, kept.P, 3 * n, sum(timings.values()), len(t_all) - 1, timings)
+    U, P = kept.whole()
+    return BiotSolution(rk, wanted, U, P, 3 * n, sum(timings.values()), len(t_all) - 1, timings)

@@ -2,7 +2,9 @@
 
 A rank holds *local* entries: its own and copies (ghosts) of entries owned by other ranks.
 ``halo`` pairs them up once; ``Halo.exchange(values)`` then overwrites every ghost entry
-with its owner's current value. Each rank talks only to the ranks it shares entries with
+with its owner's current value, and ``Halo.accumulate(values)`` goes the other way: it adds
+every ghost entry (a rank's contribution to an entry owned elsewhere, e.g. the force of its
+integration points on a ghost node) to the owner's entry. Each rank talks only to the ranks it shares entries with
 (nonblocking point-to-point messages of contiguous buffers), so the cost of an exchange
 grows with the ghost layer, not with the number of ranks.
 
@@ -55,6 +57,24 @@ class Halo:
         for rows, buf in zip(self.recv, inbox):
             if not _block(rows):
                 values[rows] = buf
+        return values
+
+
+    def accumulate(self, values: np.ndarray) -> np.ndarray:
+        """Add the ghost rows of ``values`` (shape ``(num_local, ...)``) to their owners' rows,
+        in place, neighbours in ascending rank order; the ghost rows keep their own values.
+        Returns ``values``. Collective over the neighbours."""
+        if not len(self.neighbours):
+            return values
+        tail = values.shape[1:]
+        inbox = [np.empty((len(s), *tail), values.dtype) for s in self.send]
+        requests = [self.comm.Irecv(buf, source=int(p), tag=_TAG + 1) for p, buf in zip(self.neighbours, inbox)]
+        outbox = [np.ascontiguousarray(values[r]) for r in self.recv]
+        requests += [self.comm.Isend(buf, dest=int(p), tag=_TAG + 1) for p, buf in zip(self.neighbours, outbox)]
+        for r in requests:
+            r.Wait()
+        for rows, buf in zip(self.send, inbox):
+            values[rows] += buf  # rows are distinct within one neighbour
         return values
 
 

@@ -7,6 +7,8 @@ failed step never touches the model's history. Every finished grid step is commi
 to ``recorder.record(state)``, and every ``checkpoint_every`` grid steps the stepper state,
 the model's committed history and the recorder's arrays are written atomically to
 ``checkpoint_dir``; ``resume=DIR`` continues from there and ends as an uninterrupted run would.
+A model distributed over MPI ranks (``rkfx.parallel.unknowns``) writes one checkpoint per
+rank (``rank<r>-of-<P>/``), which resumes on the same number of ranks.
 """
 import time as _time
 from collections.abc import Callable, Mapping, Sequence
@@ -18,7 +20,7 @@ import numpy as np
 
 from rkfx.errors import InputError
 from rkfx.linalg.linear_solver import Factorizations
-from rkfx.solvers.checkpoint import load_arrays, restore_run, prefixed, save_run, unprefixed
+from rkfx.solvers.checkpoint import EACH_RANK, load_arrays, rank_folder, restore_run, prefixed, save_run, unprefixed
 from rkfx.solvers.model import Model
 from rkfx.solvers.newmark import Newmark, StepState
 
@@ -128,8 +130,15 @@ def integrate(stepper: Newmark, model: Model, times: Sequence[float], *, start: 
     solves = Factorizations(comm, solver) if own else solves
     made = solves.count
     resumed = None
+    share = getattr(model, "share", None)
+    per_rank = share is not None and share.size > 1
+    writer = EACH_RANK if per_rank else comm
+
+    def folder(directory):
+        return rank_folder(directory, share.rank, share.size) if per_rank else directory
+
     if resume is not None:
-        ck = load_arrays(resume)
+        ck = load_arrays(folder(resume), common=share.least if per_rank else None)
         s = StepState.from_arrays(unprefixed(ck, "state__"))
         if s.x.shape != (model.layout.size,):
             raise InputError(f"checkpoint in {str(resume)!r} has {s.x.size} unknowns; this model has "
@@ -174,7 +183,7 @@ def integrate(stepper: Newmark, model: Model, times: Sequence[float], *, start: 
             if recorder is not None:
                 recorder.record(s)
             if checkpoint_every and (k % checkpoint_every == 0 or k == len(t_all) - 1):
-                save_run(checkpoint_dir, prefixed(s.arrays(), "state__"), model, recorder, comm)
+                save_run(folder(checkpoint_dir), prefixed(s.arrays(), "state__"), model, recorder, writer)
     finally:
         made = solves.count - made
         if own:

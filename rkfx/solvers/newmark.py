@@ -31,6 +31,7 @@ import scipy.sparse as sp
 
 from rkfx.errors import InputError
 from rkfx.linalg.linear_solver import Factorizations, linear_solver
+from rkfx.parallel.unknowns import row_system
 from rkfx.solvers.model import Constraints, Model, equation_weights, step_key
 from rkfx.solvers.newton import NewtonOptions, NewtonResult, newton
 
@@ -160,13 +161,21 @@ class Newmark:
             a = np.zeros(n)
             m = model.mass()
             o2 = np.flatnonzero(orders == 2)
-            if m is not None and o2.size:
+            share = getattr(model, "share", None)
+            if m is not None and (o2.size if share is None else share.total(o2.size)):
                 rhs = -model.residual(x, t0)
                 c = model.capacity(1.0)
                 if c is not None:
                     rhs -= c @ v
                 mm = sp.csr_matrix(m)[o2][:, o2]
-                if mm.nnz == mm.shape[0] and np.all(mm.diagonal() != 0):
+                diagonal = mm.nnz == mm.shape[0] and np.all(mm.diagonal() != 0)
+                if share is not None:  # contributions: a diagonal mass is summed entry by entry
+                    if share.least(diagonal) == 0:
+                        raise InputError("the initial acceleration of a model distributed over MPI ranks needs a "
+                                         "lumped (diagonal) mass; lump it, or pass a0")
+                    rhs, diag = share.assemble(rhs), share.assemble(sp.csr_matrix(m).diagonal())
+                    a[o2] = rhs[o2] / diag[o2]
+                elif diagonal:
                     a[o2] = rhs[o2] / mm.diagonal()
                 else:
                     ls = linear_solver(mm, comm)
@@ -221,6 +230,10 @@ class _Plan:
             raise InputError("an essential condition couples explicit and implicit unknowns; "
                              "constrain each field on its own rows")
         self.any_explicit = bool(self.on_explicit.any())
+        self.share = share = getattr(model, "share", None)
+        if share is not None and share.total(self.any_explicit):
+            raise InputError("explicit fields (beta = 0 or theta = 0) of a model distributed over MPI ranks are not "
+                             "supported; run it on one rank, or take an implicit stepper")
         self.projection = None
         if self.any_explicit:
             weight = _lumped(model.mass(), model.capacity(dt), model.layout.orders, explicit)
@@ -251,6 +264,9 @@ class _NewmarkSystem:
                  con: Constraints, t1: float, t0: float):
         self.stepper, self.model, self.plan, self.co, self.t1 = stepper, model, plan, co, t1
         self.n = len(x_t)
+        # On MPI ranks (``rkfx.parallel.unknowns``): the model's vectors and matrices are this
+        # rank's contributions over its local unknowns, the constraint rows its own.
+        self.share = plan.share
         self.M, self.C = model.mass(), model.capacity(co.dt)
         self.G, self.Gw = plan.G, plan.scaled_rows(co)
         self.W = equation_weights(model, co)
@@ -264,8 +280,13 @@ class _NewmarkSystem:
         self.c0 = self.G @ x_t - con.g
         if on_explicit.any():
             self.c0[on_explicit] = (self.G @ v_t)[on_explicit] - np.asarray(rate, float)[on_explicit]
-        self.gscale = 1.0 + (np.abs(con.g).max() if con.count else 0.0)
+        self.gscale = 1.0 + self.norm(con.g)
         self.r0 = None
+
+    def norm(self, r: np.ndarray) -> float:
+        """max |r| over all entries (and ranks)."""
+        local = float(np.abs(r).max()) if r.size else 0.0
+        return local if self.share is None else self.share.max(local)
 
     def state(self, z):
         w = z[:self.n]
@@ -274,17 +295,20 @@ class _NewmarkSystem:
 
     def residual(self, z):
         x, v, a = self.state(z)
-        r = self.model.residual(x, self.t1)
-        scale = np.abs(r).max() if r.size else 0.0
-        for mat, rate in ((self.M, a), (self.C, v)):
-            if mat is not None:
-                term = mat @ rate
-                scale = max(scale, np.abs(term).max() if term.size else 0.0)
-                r = r + term
-        self.scale = float(scale)
+        terms = [self.model.residual(x, self.t1)]
+        terms += [mat @ rate for mat, rate in ((self.M, a), (self.C, v)) if mat is not None]
         mu = z[self.n:]
-        if mu.size:
-            r = r - self.plan.GT @ mu
+        if self.share is not None:
+            # The whole model's terms at every local entry (one exchange for all of them).
+            terms.append(self.plan.GT @ mu)
+            terms = list(self.share.assemble(np.stack(terms, axis=1)).T)
+            r = sum(terms[1:-1], terms[0]) - terms[-1]
+            terms = terms[:-1]
+        else:
+            r = sum(terms[1:], terms[0])
+            if mu.size:
+                r = r - self.plan.GT @ mu
+        self.scale = max(self.norm(t) for t in terms)
         if self.W is not None:
             r = self.W * r
         return np.r_[r, self.c0 + self.Gw @ z[:self.n]]
@@ -302,11 +326,13 @@ class _NewmarkSystem:
         gt = -self.plan.GT
         if self.W is not None:
             j, gt = _scale_rows(j, self.W), _scale_rows(gt, self.W)
-        if self.G.shape[0] == 0:
-            return j.tocsr()
-        k = self.G.shape[0]  # all blocks CSR: scipy stacks them without converting to COO
-        return sp.bmat([[sp.csr_matrix(j), sp.csr_matrix(gt)], [sp.csr_matrix(self.Gw), sp.csr_matrix((k, k))]],
-                       format="csr")
+        k = self.G.shape[0]
+        if k == 0:
+            j = j.tocsr()
+        else:  # all blocks CSR: scipy stacks them without converting to COO
+            j = sp.bmat([[sp.csr_matrix(j), sp.csr_matrix(gt)], [sp.csr_matrix(self.Gw), sp.csr_matrix((k, k))]],
+                        format="csr")
+        return j if self.share is None else row_system(j, self.share, k, self.share.comm)
 
     def jacobian_key(self):
         return ("newmark", step_key(self.co.dt)) if self.model.linear else None
@@ -317,11 +343,11 @@ class _NewmarkSystem:
             return False
         eq, con = r[:self.n], r[self.n:]
         if self.r0 is None:
-            self.r0 = float(np.abs(eq).max()) if eq.size else 0.0
+            self.r0 = self.norm(eq)
         # Relative to the start and to the size of the terms at this iterate, so that
         # round-off in large cancelling forces does not stall a converged solve.
-        ok_eq = (np.abs(eq).max() if eq.size else 0.0) <= st.atol + st.rtol * max(self.r0, self.scale)
-        ok_con = (np.abs(con).max() if con.size else 0.0) <= st.ctol * self.gscale
+        ok_eq = self.norm(eq) <= st.atol + st.rtol * max(self.r0, self.scale)
+        ok_con = self.norm(con) <= st.ctol * self.gscale
         return bool(ok_eq and ok_con)
 
 

@@ -46,6 +46,9 @@ class System(Protocol):
     def converged(self, z: np.ndarray, r: np.ndarray, iteration: int) -> bool:
         """The convergence test at iterate ``iteration`` (0: the initial guess)."""
 
+    # Optional: ``norm(r)``, the largest |entry| of a vector of the system over all MPI ranks
+    # when each rank holds its part of z (default: of the whole vector on this process).
+
 
 @dataclass(frozen=True)
 class NewtonOptions:
@@ -98,7 +101,7 @@ class NewtonResult:
                            "reduce the step or check the model's parameters")
 
 
-def _norm(r: np.ndarray) -> float:
+def _local_norm(r: np.ndarray) -> float:
     return float(np.abs(r).max()) if r.size else 0.0
 
 
@@ -116,6 +119,7 @@ def newton(system: System, z0: np.ndarray, solves: Factorizations,
         solves: Where the Jacobians are factorized (and reused under their key).
         options: Iteration limits and line search.
     """
+    _norm = getattr(system, "norm", _local_norm)
     z = np.array(z0, float)
     r = system.residual(z)
     norms = [_norm(r)]
@@ -129,7 +133,7 @@ def newton(system: System, z0: np.ndarray, solves: Factorizations,
             dz = ls.solve(-r)
         except (SolverError, InputError) as err:
             return NewtonResult(z, False, SINGULAR, it, norms, str(err))
-        if not np.all(np.isfinite(dz)):
+        if not np.isfinite(_norm(dz)):
             return NewtonResult(z, False, NOT_FINITE, it + 1, norms, "the Newton step is not finite")
         if system.linear:
             return NewtonResult(z + dz, True, LINEAR, it + 1, norms)

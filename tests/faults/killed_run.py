@@ -1,6 +1,7 @@
-"""Run a small Kalthoff model through the CLI and SIGKILL the process at a chosen point.
+"""Run a small Kalthoff model (or a quick Mandel run) through the CLI and SIGKILL the process
+at a chosen point.
 
-    python tests/faults/killed_run.py OUT POINT N
+    python tests/faults/killed_run.py OUT POINT N [CASE]
 
 POINT is where the process dies:
     after-checkpoint  right after the N-th checkpoint is in place;
@@ -9,7 +10,10 @@ POINT is where the process dies:
                       before the new one replaces checkpoint.npz;
     mid-result        half-way through writing a finished run's result.npz (N-th run);
     never             run to the end.
+CASE is ``kalthoff`` (default) or ``mandel``; under mpiexec every rank dies at its own N-th
+checkpoint (one file per rank).
 """
+import importlib
 import io
 import os
 import signal
@@ -17,11 +21,12 @@ import sys
 
 import numpy as np
 
-from rkfx.cases import kalthoff
 from rkfx.solvers import checkpoint
 
 ARGS = ["--method", "rkpm", "--set", "nodes=40", "unregularized_nodes=40", "no_tracking_nodes=40", "t_end=2e-5",
         "--checkpoint-every", "20"]
+MANDEL_ARGS = ["--quick", "--method", "rkpm", "--checkpoint-every", "4"]
+CASE_ARGS = {"kalthoff": ARGS, "mandel": MANDEL_ARGS}
 
 
 def die():
@@ -29,7 +34,7 @@ def die():
     os.kill(os.getpid(), signal.SIGKILL)
 
 
-def main(out: str, point: str, n: int) -> None:
+def main(out: str, point: str, n: int, case: str = "kalthoff") -> None:
     calls = {"checkpoint": 0, "result": 0}
     savez, replace, keep = np.savez, os.replace, checkpoint._keep_as_previous
 
@@ -62,8 +67,8 @@ def main(out: str, point: str, n: int) -> None:
     checkpoint.np.savez = half_written
     checkpoint.os.replace = replaced
     checkpoint._keep_as_previous = kept
-    kalthoff.main([*ARGS, "--out", out])
+    importlib.import_module(f"rkfx.cases.{case}").main([*CASE_ARGS[case], "--out", out])
 
 
 if __name__ == "__main__":
-    main(sys.argv[1], sys.argv[2], int(sys.argv[3]))
+    main(sys.argv[1], sys.argv[2], int(sys.argv[3]), *sys.argv[4:5])
