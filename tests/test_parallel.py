@@ -134,3 +134,22 @@ def test_one_rank_by_owned_rows_equals_the_whole_assembly():
         assert np.abs(a.coefficients - b.coefficients).max() <= 1e-10 * np.abs(a.coefficients).max()
     with pytest.raises(InputError, match="distributed=True needs a nodal rule"):
         solve_plane_strain(p, MATERIAL, bcs, rule="gauss2", distributed=True)
+
+
+def test_gamg_with_rigid_body_modes_gives_the_direct_solution():
+    """CG + GAMG, given the nodes of its rows, aggregates node blocks with the rigid modes as near
+    null space: the MUMPS coefficients to its tolerance, whole or by owned rows, in a few dozen
+    iterations."""
+    pytest.importorskip("petsc4py")
+    from rkfx.linalg.petsc import LinearSolver  # noqa: PLC0415
+
+    p = structured(1.0, 1.0, 31, 31)
+    bcs = [Displacement(s, lambda x, t: FIELD.displacement(x)) for s in p.boundary_names]
+    a = solve_plane_strain(p, MATERIAL, bcs, body_force=FIELD.body_force)
+    for distributed in (False, True):
+        b = solve_plane_strain(p, MATERIAL, bcs, body_force=FIELD.body_force, solver="cg-gamg",
+                               distributed=distributed)
+        assert np.abs(a.coefficients - b.coefficients).max() <= 1e-9 * np.abs(a.coefficients).max()
+    k = sp.identity(6, format="csr")
+    with pytest.raises(InputError, match="coordinates of 2 nodes for 6 rows"):
+        LinearSolver(k, solver="cg-gamg", coordinates=np.zeros((2, 2)))

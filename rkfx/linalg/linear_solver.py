@@ -62,12 +62,14 @@ class _RowSystemSolver:
 
 
 def linear_solver(a: sp.spmatrix, comm=None, solver: str = "mumps", mumps_icntl: Mapping[int, int] | None = None,
-                  owned_rows: bool = False):
+                  owned_rows: bool = False, coordinates: np.ndarray | None = None):
     """An object with ``.solve(b)`` and ``.destroy()`` for the matrix ``a`` (``mumps_icntl``:
     further MUMPS controls, see ``rkfx.linalg.petsc.make_ksp``; ignored without PETSc).
     ``solver="serial"``: SuperLU on each rank, for a small system every rank holds whole.
     ``owned_rows``: ``a`` and every ``b`` are this rank's block of rows of a distributed system
-    (``rkfx.parallel.rows.owned_block``); ``solve`` still returns the whole solution."""
+    (``rkfx.parallel.rows.owned_block``); ``solve`` still returns the whole solution.
+    ``coordinates``: the nodes of this rank's rows of a 2-D displacement system, for the
+    rigid-body modes of ``cg-gamg`` (see ``rkfx.linalg.petsc.make_ksp``)."""
     if solver == "serial":
         return _ScipyLU(a)
     from rkfx.parallel.unknowns import RowSystem  # noqa: PLC0415
@@ -83,7 +85,8 @@ def linear_solver(a: sp.spmatrix, comm=None, solver: str = "mumps", mumps_icntl:
         if solver != "mumps" or (owned_rows and comm is not None and comm.size > 1):
             raise InputError(f"solver {solver!r}{' on distributed rows' * owned_rows} needs PETSc: pip install 'rkfx[fem]'") from None
         return _ScipyLU(a)
-    return petsc.LinearSolver(a, comm if comm is not None else petsc.MPI.COMM_WORLD, solver, mumps_icntl, owned_rows)
+    return petsc.LinearSolver(a, comm if comm is not None else petsc.MPI.COMM_WORLD, solver, mumps_icntl, owned_rows,
+                              coordinates)
 
 
 

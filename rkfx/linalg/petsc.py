@@ -91,11 +91,14 @@ def gather(vec: PETSc.Vec) -> np.ndarray:
 
 
 def make_ksp(mat: PETSc.Mat, solver: str = "mumps", rtol: float = 1e-12, prefix: str = "rkfx_",
-             mumps_icntl: Mapping[int, int] | None = None) -> PETSc.KSP:
+             mumps_icntl: Mapping[int, int] | None = None, coordinates: np.ndarray | None = None) -> PETSc.KSP:
     """A KSP for ``mat``: MUMPS LU (default), GMRES with ILU/ASM, or CG with GAMG.
 
-    ``mumps_icntl`` sets further MUMPS controls, e.g. ``{7: 2}`` for the AMF ordering. PETSc
-    options given with ``-rkfx_...`` on the command line refine the choice.
+    ``mumps_icntl`` sets further MUMPS controls, e.g. ``{7: 2}`` for the AMF ordering.
+    ``coordinates`` (cg-gamg on a 2-D displacement system, unknowns interleaved per node): the
+    coordinates of the nodes of this rank's rows, shape ``(local_rows / 2, 2)``; GAMG then
+    aggregates node blocks and keeps the three rigid-body modes on every level. PETSc options
+    given with ``-rkfx_...`` on the command line refine the choice.
     """
     if solver not in SOLVERS:
         raise InputError(f"unknown linear solver {solver!r}; choose one of {', '.join(SOLVERS)}")
@@ -124,8 +127,25 @@ def make_ksp(mat: PETSc.Mat, solver: str = "mumps", rtol: float = 1e-12, prefix:
         ksp.setType("cg")
         pc.setType("gamg")
         ksp.setTolerances(rtol=rtol, max_it=10000)
+        if coordinates is not None:
+            _rigid_body_modes(mat, coordinates)
     ksp.setFromOptions()
     return ksp
+
+
+def _rigid_body_modes(mat: PETSc.Mat, coordinates: np.ndarray) -> None:
+    """Give ``mat`` (interleaved 2-D displacements) the rigid-body modes of its nodes as its near
+    null space, for smoothed aggregation."""
+    x = np.ascontiguousarray(coordinates, dtype=PETSc.ScalarType).reshape(-1, 2)
+    lo, hi = mat.getOwnershipRange()
+    if 2 * len(x) != hi - lo:
+        raise InputError(f"coordinates of {len(x)} nodes for {hi - lo} rows; give the nodes of this rank's rows "
+                         "(2 unknowns per node, no multiplier rows)")
+    vec = PETSc.Vec().createMPI((2 * len(x), PETSc.DECIDE), bsize=2, comm=mat.getComm())
+    vec.array[:] = x.ravel()
+    mat.setBlockSize(2)
+    mat.setNearNullSpace(PETSc.NullSpace().createRigidBody(vec))
+    vec.destroy()
 
 
 class LinearSolver:
@@ -137,7 +157,8 @@ class LinearSolver:
     """
 
     def __init__(self, a: sp.spmatrix, comm=MPI.COMM_WORLD, solver: str = "mumps",
-                 mumps_icntl: Mapping[int, int] | None = None, owned_rows: bool = False):
+                 mumps_icntl: Mapping[int, int] | None = None, owned_rows: bool = False,
+                 coordinates: np.ndarray | None = None):
         self.solver, self.owned_rows = solver, owned_rows
         a = _sorted_csr(a)
         if owned_rows:  # a is this rank's block of rows (owned_rows_mat); b is too
@@ -146,7 +167,7 @@ class LinearSolver:
         else:
             self.pattern = (a.shape, a.indptr.copy(), a.indices.copy())
             self.mat = to_petsc_mat(a, comm)
-        self.ksp = make_ksp(self.mat, solver, mumps_icntl=mumps_icntl)
+        self.ksp = make_ksp(self.mat, solver, mumps_icntl=mumps_icntl, coordinates=coordinates)
         self.rhs = self.mat.createVecLeft()
         self.x = self.mat.createVecRight()
         self.residual = self.mat.createVecLeft()

@@ -104,7 +104,9 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, conditions: Sequ
         rhs = np.concatenate([f, gv])
     times["assemble"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    ls = linear_solver(system, comm, solver)
+    # GAMG aggregates node blocks and keeps the rigid modes (one rank: its rows are every node's).
+    gamg = solver == "cg-gamg" and bc_method == "nitsche" and (comm is None or comm.size == 1)
+    ls = linear_solver(system, comm, solver, coordinates=p.x if gamg else None)
     x = ls.solve(rhs)
     ls.destroy()
     times["solve"] = time.perf_counter() - t0
@@ -176,7 +178,8 @@ def _solve_by_owned_rows(p: Particles, rk: RKApproximation, domains: NodalDomain
     b = owned_entries(rhs, starts, comm)
     times["assemble"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    ls = linear_solver(block, comm, solver, owned_rows=True)
+    gamg = solver == "cg-gamg" and not mine  # displacement rows only: node blocks and rigid modes for GAMG
+    ls = linear_solver(block, comm, solver, owned_rows=True, coordinates=p.x[owned] if gamg else None)
     x = ls.solve(b)
     ls.destroy()
     times["solve"] = time.perf_counter() - t0
