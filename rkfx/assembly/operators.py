@@ -1,4 +1,5 @@
-"""Sparse operators as ``B^T D B w`` products over quadratures.
+"""Sparse operators as ``B^T D B w`` products over quadratures (the stiffness compiled:
+``rkfx.assembly.galerkin``).
 
 Degrees of freedom of vector fields are interleaved per node: (u_x0, u_y0, u_x1, ...).
 Strains use Voigt order (eps_xx, eps_yy, gamma_xy).
@@ -6,6 +7,7 @@ Strains use Voigt order (eps_xx, eps_yy, gamma_xy).
 import numpy as np
 import scipy.sparse as sp
 
+from rkfx.assembly.galerkin import elastic_stiffness
 from rkfx.errors import InputError
 from rkfx.integration.quadrature import Quadrature
 from rkfx.approximation.sparse_rows import SparseRows
@@ -21,13 +23,6 @@ def strain_matrix(grad: SparseRows) -> sp.csr_matrix:
     cols = np.concatenate([col, col + 1, col, col + 1])
     vals = np.concatenate([gx, gy, gy, gx])
     return sp.csr_matrix((vals, (rows, cols)), shape=(3 * m, 2 * n))
-
-
-def weighted_product(b: sp.csr_matrix, weights: np.ndarray, d: np.ndarray) -> sp.csr_matrix:
-    """``B^T diag_q(w_q D) B`` for a point-wise constant ``d`` of shape ``(k, k)`` (or ``(m, k, k)``)."""
-    k = b.shape[0] // len(weights)
-    d = np.broadcast_to(d, (len(weights), k, k))
-    return (b.T @ block_diagonal(weights[:, None, None] * d) @ b).tocsr()
 
 
 def block_diagonal(blocks: np.ndarray) -> sp.csr_matrix:
@@ -54,8 +49,19 @@ def stiffness(quadratures: list[Quadrature], d) -> sp.csr_matrix:
     ``d``: one ``(3, 3)`` matrix [Pa], or a list with a ``(3, 3)`` or ``(m_q, 3, 3)`` array per
     quadrature (a stiffness per point, e.g. degraded by damage).
     """
-    return sum(weighted_product(strain_matrix(q.gradients), q.weights, dq)
-               for q, dq in zip(quadratures, _per_quadrature(d, quadratures)))
+    ds = [np.asarray(dq, float) for dq in _per_quadrature(d, quadratures)]
+    if len(quadratures) == 1:
+        return elastic_stiffness(quadratures[0].gradients, quadratures[0].weights, ds[0])
+    # One pass over all the points (cell and subcell rows): no sum of whole matrices.
+    grads = [q.gradients for q in quadratures]
+    starts = np.cumsum([0] + [g.indptr[-1] for g in grads[:-1]])
+    rows = SparseRows(np.concatenate([grads[0].indptr[:1]] + [g.indptr[1:] + s for g, s in zip(grads, starts)]),
+                      np.concatenate([g.indices for g in grads]), np.concatenate([g.data for g in grads]),
+                      grads[0].num_cols)
+    same = all(dq.shape == (3, 3) and np.array_equal(dq, ds[0]) for dq in ds)
+    d_all = ds[0] if same else np.concatenate([np.broadcast_to(dq, (len(q.weights), 3, 3))
+                                               for q, dq in zip(quadratures, ds)])
+    return elastic_stiffness(rows, np.concatenate([q.weights for q in quadratures]), d_all)
 
 
 def laplacian(quadratures: list[Quadrature], k=1.0) -> sp.csr_matrix:

@@ -1,0 +1,56 @@
+"""The compiled stiffness is the product B^T diag(w D) B, entry for entry to round-off, for
+constant and per-point D, over one or several quadratures, the same on any number of threads."""
+import numba
+import numpy as np
+import scipy.sparse as sp
+
+from conftest import unit_square
+from rkfx.approximation.shape_functions import rk_approximation
+from rkfx.assembly.galerkin import elastic_stiffness
+from rkfx.assembly.operators import block_diagonal, stiffness, strain_matrix
+from rkfx.geometry.nodal_domains import nodal_domains
+from rkfx.integration.quadrature import integration_rules
+from rkfx.materials.elasticity import ElasticMaterial
+
+
+def product(q, d):
+    d = np.broadcast_to(d, (len(q.weights), 3, 3))
+    b = strain_matrix(q.gradients)
+    return b.T @ block_diagonal(q.weights[:, None, None] * d) @ b
+
+
+def test_compiled_stiffness_is_the_matrix_product():
+    p = unit_square(0.08)
+    rk, dom = rk_approximation(p.x, p.spacing), nodal_domains(p)
+    quads = integration_rules("mscni", p, rk, dom)
+    d = ElasticMaterial(2.0, 0.3).D()
+    rng = np.random.default_rng(3)
+    per_point = [d * rng.uniform(0.1, 1.0, (len(q.weights), 1, 1)) for q in quads]
+    for coefficient in (d, per_point):
+        ds = coefficient if isinstance(coefficient, list) else [d] * len(quads)
+        expected = sum(product(q, dq) for q, dq in zip(quads, ds))
+        got = stiffness(quads, coefficient)
+        assert got.has_sorted_indices and got.shape == expected.shape
+        assert abs(got - expected).max() <= 1e-13 * abs(expected).max()
+        # Every pair of nodes sharing a point keeps its whole 2 x 2 block (a fixed pattern).
+        assert got.nnz >= sp.csr_matrix(expected).nnz and got.nnz % 4 == 0
+    k = elastic_stiffness(quads[1].gradients, quads[1].weights, d)
+    assert abs(k - product(quads[1], d)).max() <= 1e-13 * abs(k).max()
+    assert abs(k - k.T).max() <= 1e-13 * abs(k).max()
+
+
+def test_compiled_stiffness_does_not_depend_on_the_thread_count():
+    p = unit_square(0.08)
+    rk, dom = rk_approximation(p.x, p.spacing), nodal_domains(p)
+    quads = integration_rules("mscni", p, rk, dom)
+    d = ElasticMaterial(2.0, 0.3).D()
+    threads = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = stiffness(quads, d)
+        numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+        many = stiffness(quads, d)
+    finally:
+        numba.set_num_threads(threads)
+    assert np.array_equal(one.indptr, many.indptr) and np.array_equal(one.indices, many.indices)
+    assert np.array_equal(one.data, many.data)
