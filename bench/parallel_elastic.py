@@ -8,6 +8,8 @@ to a serial run's saved with ``--save``.
 Usage:
     python bench/parallel_elastic.py [--nodes 300] [--save serial.npy]
     mpiexec -n 2 env NUMBA_NUM_THREADS=1 python bench/parallel_elastic.py --compare serial.npy
+    python bench/parallel_elastic.py --nodes 1000 --solver cg-gamg   (10^6 nodes: ~9 GB serially)
+Further PETSc options through PETSC_OPTIONS, e.g. "-rkfx_pc_gamg_threshold 0.02".
 The last line printed reads ``<ranks> ranks x <threads> threads, <N> nodes: <seconds> s``.
 """
 import argparse
@@ -33,7 +35,7 @@ def main() -> None:
     ap.add_argument("--solver", default="mumps", help="mumps | gmres-ilu | cg-gamg")
     ap.add_argument("--save", help="write the coefficients (rank 0) to this .npy file")
     ap.add_argument("--compare", help="report the relative difference to these saved coefficients")
-    args, _petsc_options = ap.parse_known_args()  # the rest: PETSc options (-rkfx_...)
+    args = ap.parse_args()
     comm = MPI.COMM_WORLD
     warm_up()
     p = structured(1.0, 1.0, args.nodes, args.nodes)

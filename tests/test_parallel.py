@@ -16,7 +16,7 @@ from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.models.elastostatics import elastic_terms, solve_plane_strain
 from rkfx.parallel.ownership import nodal_integration_points, numbering, ownership
 from rkfx.parallel.partition import rcb
-from rkfx.parallel.rows import owned_block, owned_entries
+from rkfx.parallel.rows import owned_block, owned_entries, renumbered
 from verification.manufactured import SineField
 
 MATERIAL = ElasticMaterial(1.0, 0.3)
@@ -153,3 +153,11 @@ def test_gamg_with_rigid_body_modes_gives_the_direct_solution():
     k = sp.identity(6, format="csr")
     with pytest.raises(InputError, match="coordinates of 2 nodes for 6 rows"):
         LinearSolver(k, solver="cg-gamg", coordinates=np.zeros((2, 2)))
+
+
+def test_renumbered_moves_rows_and_columns():
+    a = sp.random(7, 7, density=0.5, random_state=2, format="csr")
+    new = np.array([9, 2, 0, 5, 3, 8, 1])
+    got = renumbered(a, new, 10)
+    expected = sp.csr_matrix((a.tocoo().data, (new[a.tocoo().row], new[a.tocoo().col])), shape=(10, 10))
+    assert got.has_sorted_indices and abs(got - expected).max() == 0 and got.nnz == a.nnz

@@ -119,11 +119,16 @@ def smoothed_gradients(p: Particles, rk: RKApproximation, domains: NodalDomains,
         ptr = np.zeros(len(nodes) + 1, np.int64)
         np.cumsum(lengths, out=ptr[1:])
         terms = np.repeat(d.cell_ptr[nodes] - ptr[:-1], lengths) + np.arange(ptr[-1])
-        used = np.unique(np.concatenate([d.cell_point[terms], d.subcell_point[sub].ravel() if subcells else []])
-                         .astype(np.int64))
+        keep = np.zeros(len(d.smoothing_points), bool)  # a mask: linear time, unlike a sort
+        keep[d.cell_point[terms]] = True
+        if subcells:
+            keep[d.subcell_point[sub].ravel()] = True
+        used = np.flatnonzero(keep)
+        position = np.full(len(keep), -1, np.int64)
+        position[used] = np.arange(len(used))
 
     def local(point):  # index among the evaluated smoothing points
-        return point if used is None else np.searchsorted(used, point)
+        return point if used is None else position[point]
 
     at_points = evaluate(rk, d.smoothing_points if used is None else d.smoothing_points[used])
     cell = combine_rows(at_points, ptr, local(d.cell_point[terms]),

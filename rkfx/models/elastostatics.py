@@ -22,7 +22,7 @@ from rkfx.geometry.particles import Particles
 from rkfx.integration.quadrature import NODAL_RULES, integration_rules
 from rkfx.parallel.ownership import numbering
 from rkfx.parallel.partition import rcb
-from rkfx.parallel.rows import owned_block, owned_entries
+from rkfx.parallel.rows import owned_block, owned_entries, renumbered
 from rkfx.approximation.shape_functions import RKApproximation, evaluate, rk_approximation
 
 
@@ -107,6 +107,7 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, conditions: Sequ
     # GAMG aggregates node blocks and keeps the rigid modes (one rank: its rows are every node's).
     gamg = solver == "cg-gamg" and bc_method == "nitsche" and (comm is None or comm.size == 1)
     ls = linear_solver(system, comm, solver, coordinates=p.x if gamg else None)
+    del k, system  # PETSc holds its own copy
     x = ls.solve(rhs)
     ls.destroy()
     times["solve"] = time.perf_counter() - t0
@@ -167,19 +168,21 @@ def _solve_by_owned_rows(p: Particles, rk: RKApproximation, domains: NodalDomain
     unknown = np.concatenate([(first[:, None] + np.arange(2)).ravel(),
                               starts[rank] + 2 * len(owned) + np.arange(mine)])
     if mine:
-        k = sp.bmat([[k, g.T], [g, None]], format="coo")
+        k = sp.bmat([[k, g.T], [g, None]], format="csr")
         f = np.concatenate([f, gv])
-    k = sp.coo_matrix(k)
     total = int(starts[-1])
-    contribution = sp.csr_matrix((k.data, (unknown[k.row], unknown[k.col])), shape=(total, total))
+    contribution = renumbered(k, unknown, total)
+    del k  # the largest arrays go as soon as their successor stands
     rhs = np.zeros(total)
     rhs[unknown] = f
     block = owned_block(contribution, starts, comm)
+    del contribution
     b = owned_entries(rhs, starts, comm)
     times["assemble"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     gamg = solver == "cg-gamg" and not mine  # displacement rows only: node blocks and rigid modes for GAMG
     ls = linear_solver(block, comm, solver, owned_rows=True, coordinates=p.x[owned] if gamg else None)
+    del block  # PETSc holds its own copy
     x = ls.solve(b)
     ls.destroy()
     times["solve"] = time.perf_counter() - t0

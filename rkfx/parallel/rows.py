@@ -44,6 +44,31 @@ def owned_block(a: sp.spmatrix, ranges: np.ndarray, comm=None) -> sp.csr_matrix:
     return mine
 
 
+def renumbered(a: sp.spmatrix, new: np.ndarray, size: int) -> sp.csr_matrix:
+    """``a`` with row and column i moved to ``new[i]``, shape ``(size, size)``, sorted indices.
+
+    Args:
+        a: Square, shape ``(m, m)``.
+        new: Distinct new indices of a's rows and columns, shape ``(m,)``, in ``0..size-1``.
+        size: Rows and columns of the result (the rows not in ``new`` are empty).
+    """
+    a = sp.csr_matrix(a)
+    new = np.asarray(new, np.int64)
+    source = np.full(size, -1, np.int64)
+    source[new] = np.arange(len(new))
+    lengths = np.zeros(size, np.int64)
+    filled = source >= 0
+    lengths[filled] = np.diff(a.indptr)[source[filled]]
+    indptr = np.zeros(size + 1, np.int64)
+    np.cumsum(lengths, out=indptr[1:])
+    rows = np.flatnonzero(lengths)
+    # Entry e of the result comes from entry at[e] of a: one gather, no COO round trip.
+    at = np.repeat(a.indptr[source[rows]] - indptr[rows], lengths[rows]) + np.arange(indptr[-1])
+    out = sp.csr_matrix((a.data[at], new[a.indices[at]], indptr), shape=(size, size))
+    out.sort_indices()
+    return out
+
+
 def owned_entries(v: np.ndarray, ranges: np.ndarray, comm=None) -> np.ndarray:
     """The entries ``ranges[rank]:ranges[rank + 1]`` of the sum over ranks of the vector ``v``
     (this rank's contribution, nonzero on its owned and ghost unknowns only)."""
