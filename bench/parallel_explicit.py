@@ -46,7 +46,7 @@ def main() -> None:
     material = dm.DamageMaterial(prm["E"], prm["nu"], prm["ft"], prm["GF"], "strain")
     comm.Barrier()
     t0 = time.perf_counter()
-    pl, track, model = k.setup(args.nodes, material, prm)
+    pl, track, model = k.setup(args.nodes, material, prm, comm=comm)
     setup = time.perf_counter() - t0
     run = dyn.simulate("bench", pl, model, track, k.model_conditions(pl, prm["v0"]), args.t_end, comm=comm)
     stepping = comm.allreduce(run.wall_time_s, op=MPI.MAX)

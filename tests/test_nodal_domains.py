@@ -60,3 +60,24 @@ def test_second_moments_match_independent_quadrature():
             for c, f in enumerate((r[:, 0] ** 2, r[:, 0] * r[:, 1], r[:, 1] ** 2)):
                 moments[:, c] += np.bincount(d.subcell_node, area / 3 * f, p.num_nodes)
     assert np.allclose(d.second_moment, moments, rtol=1e-12, atol=1e-16)
+
+
+def test_domains_around_some_nodes_give_their_cells_as_the_whole_build():
+    """A rank's build (``nodes=``) holds fewer subcells, and its nodes' areas, moments and
+    smoothed gradients are the whole build's."""
+    from rkfx.approximation.shape_functions import rk_approximation  # noqa: PLC0415
+    from rkfx.integration.quadrature import smoothed_gradients  # noqa: PLC0415
+    from rkfx.parallel.partition import rcb  # noqa: PLC0415
+
+    p = unit_square(0.08)
+    rk = rk_approximation(p.x, p.spacing)
+    whole = nodal_domains(p)
+    mine = np.flatnonzero(rcb(p.x, 3) == 1)
+    part = nodal_domains(p, nodes=mine)
+    assert len(part.subcell_area) < len(whole.subcell_area)
+    assert np.array_equal(part.area[mine], whole.area[mine])
+    assert np.array_equal(part.second_moment[mine], whole.second_moment[mine])
+    a, b = (smoothed_gradients(p, rk, d, subcells=True, nodes=mine) for d in (whole, part))
+    for x, y in ((a.cell, b.cell), (a.cell_minus_subcell, b.cell_minus_subcell)):
+        assert np.array_equal(x.indptr, y.indptr) and np.array_equal(x.indices, y.indices)
+        assert np.abs(x.data - y.data).max() <= 1e-12 * np.abs(x.data).max()

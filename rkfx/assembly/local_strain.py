@@ -19,8 +19,9 @@ One force evaluation, on local vectors (interleaved over the local nodes):
 
 Every sum runs over the same entries in the same order as the serial operator's, so the
 strains and forces equal the serial ones bit for bit, and so does a whole explicit run on
-any number of ranks. Today the global operator is built on every rank and sliced here; each
-rank keeps its slice only.
+any number of ranks. A rank slices these from an operator holding only the rows it reads
+(``StrainRecipe.share``: its particles' and those of the particles near its part), so no rank
+builds the whole operator.
 """
 from dataclasses import dataclass
 

@@ -281,16 +281,25 @@ def check_eps_p(eps_p: float) -> None:
 
 
 def smeared_strain(p: Particles, rk: RKApproximation, domains: NodalDomains | None = None,
-                   eps_p: float = 0.0) -> SmearedStrain:
+                   eps_p: float = 0.0, points: np.ndarray | None = None) -> SmearedStrain:
     """B~ from the SCNI smoothed gradients on the nodal cells (eq. 3.55 = eq. 4.33), with the
-    MSCNI subcell terms of eq. (3.56) when ``eps_p`` > 0 (1 is the usual choice)."""
+    MSCNI subcell terms of eq. (3.56) when ``eps_p`` > 0 (1 is the usual choice).
+
+    ``points`` (ascending particle indices) builds only the rows of those particles (the others
+    stay empty, in their places): enough for a rank's ``local_smeared_strain`` when they are
+    its own particles and every particle whose rows touch one of its nodes (``near_part``).
+    """
     check_eps_p(eps_p)
     domains = domains or nodal_domains(p)
     volume = np.ascontiguousarray(domains.area, dtype=np.float64)
     if eps_p == 0:
-        cell = smoothed_gradients(p, rk, domains, subcells=False).cell
+        if points is None:
+            cell = smoothed_gradients(p, rk, domains, subcells=False).cell
+        else:
+            cell = _spread(smoothed_gradients(p, rk, domains, subcells=False, nodes=points).cell, points,
+                           p.num_nodes)
         return SmearedStrain(cell, transpose_rows(cell), volume)
-    cell, sub, order = subcell_gradients(rk, domains)
+    cell, sub, order = subcell_gradients(rk, domains, nodes=points)
     owner = np.ascontiguousarray(domains.subcell_node[order])
     ptr = np.zeros(p.num_nodes + 1, np.int64)
     np.cumsum(np.bincount(owner, minlength=p.num_nodes), out=ptr[1:])
@@ -305,6 +314,67 @@ def smeared_strain(p: Particles, rk: RKApproximation, domains: NodalDomains | No
         raise InputError(f"the subcells do not partition the nodal cells (cell and subcell strains differ by "
                          f"{gap:.1e}); use eps_p=0 with these domains or rebuild them with nodal_domains/grid_domains")
     return op
+
+
+@dataclass(frozen=True)
+class StrainRecipe:
+    """What ``smeared_strain`` builds B~ from, for a run that builds it itself: whole on one rank,
+    on MPI ranks only the rows of each rank's share (``rkfx.models.damage_ranks``), so that no
+    rank ever holds the whole operator.
+
+    Attributes:
+        p, rk, domains: Particles, their RK approximation and nodal domains.
+        eps_p: MSCNI weight (0: plain SCNI).
+    """
+
+    p: Particles
+    rk: RKApproximation
+    domains: NodalDomains
+    eps_p: float = 0.0
+
+    @property
+    def num_nodes(self) -> int:
+        return self.p.num_nodes
+
+    def build(self, points: np.ndarray | None = None) -> SmearedStrain:
+        """``smeared_strain`` of the recipe (only the rows of ``points`` if given)."""
+        return smeared_strain(self.p, self.rk, self.domains, self.eps_p, points=points)
+
+    def share(self, part: np.ndarray, rank: int) -> SmearedStrain:
+        """The rows that rank ``rank`` of the partition ``part`` reads: its particles' and every
+        particle's whose rows touch one of its nodes (``near_part``)."""
+        margin = 1.001 * (self.rk.support.max() + reach(self.p.x, self.domains))
+        return self.build(near_part(self.p.x, part, rank, margin))
+
+
+def _spread(rows: SparseRows, at: np.ndarray, num_rows: int) -> SparseRows:
+    """``rows`` placed as the rows ``at`` (ascending) of ``num_rows`` rows, the others empty."""
+    lengths = np.zeros(num_rows, np.int64)
+    lengths[at] = np.diff(rows.indptr)
+    indptr = np.zeros(num_rows + 1, np.int64)
+    np.cumsum(lengths, out=indptr[1:])
+    return SparseRows(indptr, rows.indices, rows.data, rows.num_cols)
+
+
+def near_part(x: np.ndarray, part: np.ndarray, rank: int, margin: float) -> np.ndarray:
+    """The particles (ascending) of part ``rank`` and those within ``margin`` of its bounding
+    box: with ``margin`` at least the largest support plus the farthest smoothing point of a
+    particle from it, every particle whose rows touch a node of the part."""
+    x = np.asarray(x, float)
+    own = x[np.asarray(part) == rank]
+    if own.size == 0:
+        return np.zeros(0, np.int64)
+    lo, hi = own.min(axis=0) - margin, own.max(axis=0) + margin
+    return np.flatnonzero(np.all((x >= lo) & (x <= hi), axis=1) | (np.asarray(part) == rank))
+
+
+def reach(x: np.ndarray, domains: NodalDomains) -> float:
+    """The largest distance from a particle (coordinates ``x``) to one of its smoothing points [m]."""
+    d = domains
+    cell_node = np.repeat(np.arange(len(d.area)), np.diff(d.cell_ptr))
+    far = np.linalg.norm(d.smoothing_points[d.cell_point] - x[cell_node], axis=1).max(initial=0.0)
+    sub = np.linalg.norm(d.smoothing_points[d.subcell_point] - x[d.subcell_node][:, None], axis=2)
+    return float(max(far, sub.max(initial=0.0)))
 
 
 def elastic_force(op: SmearedStrain, d_matrix: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:

@@ -26,7 +26,7 @@ import numpy as np
 from rkfx.fracture import damage as dm
 from rkfx.fracture.tracking import Tracking
 from rkfx.approximation.diffraction import Cracks, cracks
-from rkfx.assembly.smeared_strain import SmearedStrain, lumped_mass, smeared_strain, stable_time_step
+from rkfx.assembly.smeared_strain import SmearedStrain, StrainRecipe, lumped_mass, stable_time_step
 from rkfx.models.damage_dynamics import DamageRun, run_damage
 from rkfx.geometry.grid_cells import grid_domains
 from rkfx.geometry.nodal_domains import NodalDomains
@@ -47,7 +47,8 @@ class Plate:
         p: Particles (node j * nx + i at (xs[i], ys[j])).
         rk: RK approximation with the cracks.
         domains: Rectangular Voronoi cells.
-        op: Smeared strain operator B~ (4.31)-(4.33).
+        op: Smeared strain operator B~ (4.31)-(4.33); on MPI ranks its recipe, from which each
+            rank of ``simulate`` builds only the rows of its share.
         mass: Lumped mass per unknown [kg per unit thickness].
         dt: Time step [s].
         cracks: The pre-existing cracks.
@@ -58,7 +59,7 @@ class Plate:
     p: Particles
     rk: RKApproximation
     domains: NodalDomains
-    op: SmearedStrain
+    op: SmearedStrain | StrainRecipe
     mass: np.ndarray
     dt: float
     cracks: Cracks
@@ -90,15 +91,18 @@ def memory_need(methods: Sequence[str], rkpm: dict[str, Sequence], fem: dict[str
 
 def plate(xs: np.ndarray, ys: np.ndarray, slits: Sequence, tips: Sequence[tuple[bool, bool]],
           material: dm.DamageMaterial, rho: float, support_factor: float = 1.5, courant: float = 0.5,
-          eps_p: float = 1.0) -> Plate:
+          eps_p: float = 1.0, comm=None) -> Plate:
     """Particles, RK shape functions (linear basis, cubic B-spline kernel, support c h) with the
     cracks ``slits`` (free tips flagged by ``tips``), SCNI cells with the MSCNI terms of weight
-    ``eps_p`` (0: plain SCNI), lumped mass and the CFL step."""
+    ``eps_p`` (0: plain SCNI), lumped mass and the CFL step. With an MPI ``comm`` of several
+    ranks the operator is left as its recipe: each rank of ``simulate`` builds only the rows of
+    its share."""
     p = graded(xs, ys)
     c = cracks([np.asarray(s, float) for s in slits], tips)
     rk = rk_approximation(p.x, p.spacing, support_factor, cracks=c)
     domains = grid_domains(xs, ys, slits)
-    op = smeared_strain(p, rk, domains, eps_p)
+    recipe = StrainRecipe(p, rk, domains, eps_p)
+    op = recipe if comm is not None and comm.size > 1 else recipe.build()
     dt = stable_time_step(p.spacing, material.elastic, rho, courant)
     return Plate(np.asarray(xs, float), np.asarray(ys, float), p, rk, domains, op, lumped_mass(domains.area, rho),
                  dt, c)

@@ -160,7 +160,7 @@ def traction_force(pl: dyn.Plate, sigma: float) -> np.ndarray:
 def _rkpm(label, study, h, material, prm, regularized=True, kappa_c=None, **io) -> Run:
     xs, ys = grid(h)
     pl = dyn.plate(xs, ys, [((0.0, A2), (A1, A2))], [(False, True)], material, prm["rho"], prm["support_factor"],
-                   prm["courant"], prm["eps_p"])
+                   prm["courant"], prm["eps_p"], io.get("comm"))
     seeds = np.linalg.norm(pl.p.x - np.array([A1, A2]), axis=1) < 0.75 * pl.h
     track = tracking(pl.p.x, pl.p.spacing, prm["tol"], seeds, prm["radius"], forward=prm["forward"])
     model = dyn.damage_model(pl, material, regularized, kappa_c)

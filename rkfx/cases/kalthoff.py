@@ -152,12 +152,13 @@ def model_conditions(pl: dyn.Plate, v0: float):
 
 
 def setup(n: int, material: dm.DamageMaterial, prm: dict, regularized: bool = True, kappa_c: float | None = None,
-          tracked: bool = True) -> tuple[dyn.Plate, object, dm.DamageModel]:
+          tracked: bool = True, comm=None) -> tuple[dyn.Plate, object, dm.DamageModel]:
     """The plate of about ``n`` particles per side, its tracking (the four particles around the
-    tip seed it) and damage model, for the parameters ``prm`` (``PARAMS`` names)."""
+    tip seed it) and damage model, for the parameters ``prm`` (``PARAMS`` names); ``comm``: the
+    MPI communicator its run will be distributed over (``dyn.plate``)."""
     xs, ys = grid(n)
     pl = dyn.plate(xs, ys, [((0.0, A2), (A1, A2))], [(False, True)], material, prm["rho"], prm["support_factor"],
-                   prm["courant"], prm["eps_p"])
+                   prm["courant"], prm["eps_p"], comm)
     seeds = np.linalg.norm(pl.p.x - np.array([A1, A2]), axis=1) < 0.75 * pl.h
     track = tracking(pl.p.x, pl.p.spacing, prm["tol"], seeds, prm["radius"], enabled=tracked,
                      forward=prm["forward"])
@@ -165,7 +166,7 @@ def setup(n: int, material: dm.DamageMaterial, prm: dict, regularized: bool = Tr
 
 
 def _rkpm(label, study, n, material, prm, regularized=True, kappa_c=None, tracked=True, **io) -> Run:
-    pl, track, model = setup(n, material, prm, regularized, kappa_c, tracked)
+    pl, track, model = setup(n, material, prm, regularized, kappa_c, tracked, io.get("comm"))
     r = dyn.simulate(label, pl, model, track, model_conditions(pl, prm["v0"]), prm["t_end"], **io)
     return _run_record(r, study, n, pl.p.x, (len(pl.xs), len(pl.ys)), pl.h, prm, 2 * pl.p.num_nodes)
 

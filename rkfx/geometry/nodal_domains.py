@@ -199,13 +199,25 @@ def _cell_lists(n, tri, edge_of, is_boundary, side_point, nl_sub):
     return ptr, point, nl
 
 
-def nodal_domains(p: Particles) -> NodalDomains:
-    """Median-dual nodal domains of a ``Particles`` set (compiled loops over triangles)."""
+def nodal_domains(p: Particles, nodes: np.ndarray | None = None) -> NodalDomains:
+    """Median-dual nodal domains of a ``Particles`` set (compiled loops over triangles).
+
+    ``nodes`` (indices, e.g. a rank's own nodes) builds only the triangles around them: their
+    cells, areas and moments are whole and equal to the whole build's, the subcells are those
+    of those triangles (of their own and their neighbours' corners), and the other nodes' cells
+    are partial or empty. Node indices stay global. The smoothing points are numbered for
+    this build alone; the boundary is whole.
+    """
     x, tri, n = p.x, p.triangles, p.num_nodes
     edges, edge_of = p.edges, p.triangle_edges
     ne = len(edges)
-    points, area, centroid, moments, nl, side_point = _subcells(x, tri, edge_of, edges)
     is_boundary = (np.bincount(edge_of.ravel(), minlength=ne) == 1).astype(np.int64)
+    if nodes is not None:
+        mine = np.zeros(n, bool)
+        mine[np.asarray(nodes, np.int64)] = True
+        around = mine[tri].any(axis=1)
+        tri, edge_of = np.ascontiguousarray(tri[around]), np.ascontiguousarray(edge_of[around])
+    points, area, centroid, moments, nl, side_point = _subcells(x, tri, edge_of, edges)
     cell_ptr, cell_point, cell_nl = _cell_lists(n, tri, edge_of, is_boundary, side_point, nl)
     # Boundary: each boundary edge (i -> j, domain on the left) split at its midpoint; the
     # half-segment midpoints are the edge's quarter points.

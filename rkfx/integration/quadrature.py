@@ -144,24 +144,52 @@ def smoothed_gradients(p: Particles, rk: RKApproximation, domains: NodalDomains,
     return SmoothedGradients(cell, evaluate(rk, p.x[nodes]), diff, nodes, sub)
 
 
-def subcell_gradients(rk: RKApproximation, domains: NodalDomains
+def subcell_gradients(rk: RKApproximation, domains: NodalDomains, nodes: np.ndarray | None = None
                       ) -> tuple[SparseRows, SparseRows, np.ndarray]:
     """The smoothed gradients of eq. (3.55) over each cell, grad~N_I(x_L), and over each of
     its subcells, grad~N_I(x_hat_C) (the subcell rows of eq. 3.56), from one evaluation of N
     at the smoothing points.
+
+    ``nodes`` (ascending indices) fills only the rows of those particles' cells and subcells,
+    evaluating N only at their smoothing points; the other rows stay empty, so the rows keep
+    their places (a rank's share of an explicit run, ``rkfx.assembly.local_strain``). Each
+    filled row equals the whole build's entry for entry.
 
     Returns:
         (cell rows, subcell rows, order): subcell row k belongs to subcell ``order[k]`` of
         ``domains``; the rows are grouped by particle (stable sort of ``subcell_node``).
     """
     d = domains
-    at_points = evaluate(rk, d.smoothing_points)
-    cell = combine_rows(at_points, d.cell_ptr, d.cell_point,
-                        d.cell_normal_length / np.repeat(d.area, np.diff(d.cell_ptr))[:, None])
     order = np.argsort(d.subcell_node, kind="stable")
     ns = len(order)
-    sub = combine_rows(at_points, np.arange(0, 4 * ns + 1, 4), d.subcell_point[order].ravel(),
-                       (d.subcell_normal_length[order] / d.subcell_area[order, None, None]).reshape(-1, 2))
+    cell_length = np.diff(d.cell_ptr)
+    if nodes is None:
+        at_points = evaluate(rk, d.smoothing_points)
+        cell_ptr, cell_terms, sub_ptr, sub_terms = d.cell_ptr, np.arange(len(d.cell_point)), \
+            np.arange(0, 4 * ns + 1, 4), np.arange(4 * ns)
+        local = d.cell_point, d.subcell_point[order].ravel()
+    else:
+        mine = np.zeros(len(d.area), bool)
+        mine[nodes] = True
+        cell_ptr = np.zeros(len(d.area) + 1, np.int64)
+        np.cumsum(np.where(mine, cell_length, 0), out=cell_ptr[1:])
+        cell_terms = np.flatnonzero(np.repeat(mine, cell_length))
+        sub_mine = mine[d.subcell_node[order]]
+        sub_ptr = np.zeros(ns + 1, np.int64)
+        np.cumsum(np.where(sub_mine, 4, 0), out=sub_ptr[1:])
+        sub_terms = np.flatnonzero(np.repeat(sub_mine, 4))
+        keep = np.zeros(len(d.smoothing_points), bool)
+        keep[d.cell_point[cell_terms]] = True
+        keep[d.subcell_point[order].ravel()[sub_terms]] = True
+        used = np.flatnonzero(keep)
+        position = np.full(len(keep), -1, np.int64)
+        position[used] = np.arange(len(used))
+        at_points = evaluate(rk, d.smoothing_points[used])
+        local = position[d.cell_point], position[d.subcell_point[order].ravel()]
+    cell = combine_rows(at_points, cell_ptr, local[0][cell_terms],
+                        (d.cell_normal_length / np.repeat(d.area, cell_length)[:, None])[cell_terms])
+    sub = combine_rows(at_points, sub_ptr, local[1][sub_terms],
+                       (d.subcell_normal_length[order] / d.subcell_area[order, None, None]).reshape(-1, 2)[sub_terms])
     return cell, sub, order
 
 

@@ -59,7 +59,7 @@ from rkfx.fracture.damage import DamageModel, crack_opening, dissipation_density
 from rkfx.materials.damage_law import damage_kernel, strain_kernel
 from rkfx.errors import InputError
 from rkfx.parallel.ranks import on_root
-from rkfx.assembly.smeared_strain import SmearedStrain
+from rkfx.assembly.smeared_strain import SmearedStrain, StrainRecipe
 from rkfx.solvers.central_difference import CentralDifference, Constraint, ExplicitDynamics, ExplicitState
 from rkfx.solvers.checkpoint import copy_into, has_checkpoint, log, read_arrays, run_folder, save_arrays
 
@@ -338,8 +338,9 @@ def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, mode
 
     Args:
         label: Run label (also the sub-directory of ``work_dir``/``resume``).
-        op, mass, dt: Strain operator of the damage points, lumped mass per unknown [kg] and
-            time step [s].
+        op, mass, dt: Strain operator of the damage points (or the ``StrainRecipe`` of a
+            ``SmearedStrain``, which each rank of a distributed run builds only its share of),
+            lumped mass per unknown [kg] and time step [s].
         model, track: Damage points and tracking (``None``: every point may damage).
         constraints, external_force: As for ``DamageDynamics``.
         checkpoint_every: Checkpoint every so many steps (needs ``work_dir``).
@@ -353,7 +354,9 @@ def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, mode
         x: Particle positions, shape ``(n, 2)`` [m], which the ranks split by RCB.
     """
     parallel = comm is not None and comm.size > 1
-    if parallel and (x is None or not isinstance(op, SmearedStrain)):
+    if isinstance(op, StrainRecipe) and not (parallel and x is not None):
+        op = op.build()  # one process builds the whole operator
+    if parallel and (x is None or not isinstance(op, SmearedStrain | StrainRecipe)):
         return on_root(comm, lambda: run_damage(label, op, mass, dt, model, track, constraints, t_end,
                                                 external_force, samples, checkpoint_every, work_dir, resume))
     if not t_end > 0:

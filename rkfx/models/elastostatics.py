@@ -89,12 +89,12 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, conditions: Sequ
     times = {}
     t0 = time.perf_counter()
     rk = rk_approximation(p.x, p.spacing, support_factor, order)
-    domains = nodal_domains(p)
     terms = dict(material=material, displacements=displacements, tractions=tractions, body_force=body_force,
                  rule=rule, bc_method=bc_method, nitsche_penalty=nitsche_penalty)
     if distributed:
-        coefficients = _solve_by_owned_rows(p, rk, domains, terms, comm, solver, times, t0)
+        coefficients = _solve_by_owned_rows(p, rk, terms, comm, solver, times, t0)
         return ElasticSolution(rk, coefficients, 2 * p.num_nodes, times)
+    domains = nodal_domains(p)
     k, f, g, gv = elastic_terms(p, rk, domains, **terms)
     _check_rigid_modes(p, g)
     if bc_method == "nitsche":
@@ -142,12 +142,13 @@ def elastic_terms(p: Particles, rk: RKApproximation, domains: NodalDomains, mate
     return k, f, g, gv
 
 
-def _solve_by_owned_rows(p: Particles, rk: RKApproximation, domains: NodalDomains, terms: dict, comm,
-                         solver: str, times: dict, t0: float) -> np.ndarray:
+def _solve_by_owned_rows(p: Particles, rk: RKApproximation, terms: dict, comm, solver: str, times: dict,
+                         t0: float) -> np.ndarray:
     """The coefficients, shape ``(n, 2)``, on every rank, from a system assembled by owned rows.
 
-    The nodes are split by RCB (``rkfx.parallel.partition``); each rank integrates over its
-    nodes' cells only (``elastic_terms`` with ``nodes``), renumbers its contributions so that
+    The nodes are split by RCB (``rkfx.parallel.partition``); each rank builds the nodal
+    domains around its nodes and integrates over its nodes' cells only (``nodal_domains`` and
+    ``elastic_terms`` with ``nodes``), renumbers its contributions so that
     each rank's unknowns are contiguous (its nodes' displacements, then the multipliers of the
     collocation rows at its nodes), sends the rows owned elsewhere to their owners
     (``rkfx.parallel.rows``) and hands its block of rows to a preallocated PETSc matrix.
@@ -157,7 +158,7 @@ def _solve_by_owned_rows(p: Particles, rk: RKApproximation, domains: NodalDomain
     part = rcb(p.x, size)
     num = numbering(part, size)
     owned = num.old_of_new[num.ranges[rank]:num.ranges[rank + 1]]
-    k, f, g, gv = elastic_terms(p, rk, domains, nodes=owned, **terms)
+    k, f, g, gv = elastic_terms(p, rk, nodal_domains(p, nodes=owned), nodes=owned, **terms)
     _check_rigid_modes(p, g, comm)
     mine = g.shape[0] if terms["bc_method"] == "transformation" else 0
     multipliers = np.array(comm.allgather(mine) if size > 1 else [mine])

@@ -253,7 +253,10 @@ def biot_operators(p: Particles, rk: RKApproximation, domains: NodalDomains, mat
             rows.append(stab.values)
             weights.append(stab.weights)
             row_nodes.append(owner)
-    return BiotOperators(kuu, kup, ks, kh, rows, weights, row_nodes, np.sqrt(d.area))
+    h = np.sqrt(d.area)
+    if nodes is not None:  # the other nodes' cells may be partial (domains built around ``nodes``)
+        h = np.where(np.isin(np.arange(n), mine), h, 1.0)
+    return BiotOperators(kuu, kup, ks, kh, rows, weights, row_nodes, h)
 
 
 # Boundary conditions: the core's vocabulary (``rkfx.conditions``); a traction of the u-p
@@ -455,12 +458,14 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
     timings = {}
     t0 = time.perf_counter()
     rk = rk_approximation(p.x, p.spacing, support_factor) if rk is None else rk
-    d = nodal_domains(p) if domains is None else domains
     n = p.num_nodes
     num = mine = segments = None
     if distributed:
         num = numbering(rcb(p.x, comm.size), comm.size)
         mine = num.old_of_new[num.ranges[comm.rank]:num.ranges[comm.rank + 1]]
+    # On ranks, only the domains around the rank's own nodes (the cells it integrates over).
+    d = nodal_domains(p, nodes=mine) if domains is None else domains
+    if distributed:
         segments = np.flatnonzero(np.isin(d.boundary.node, mine))
     ops = biot_operators(p, rk, d, material, variant, fields=fields, nodes=mine)
     bq = boundary_quadrature(p, d, rk, segments=segments)
