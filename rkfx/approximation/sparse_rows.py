@@ -114,7 +114,8 @@ def _combine(src_ptr, src_idx, src_val, term_ptr, term_row, term_w, num_cols, nc
                 out_ptr[r + 1] = k
 
 
-def _work_items(nrows: int) -> int:
+def work_items(nrows: int) -> int:
+    """Parallel work items for ``nrows`` rows: ``ITEMS_PER_THREAD`` per thread, at most one per row."""
     return max(1, min(nrows, ITEMS_PER_THREAD * numba.get_num_threads()))
 
 
@@ -158,7 +159,7 @@ def combine_rows(source: SparseRows, term_ptr: np.ndarray, term_row: np.ndarray,
         base_args = (base.indptr, base.indices, np.ascontiguousarray(base.data),
                      np.ascontiguousarray(base_row, dtype=np.int64))
     args = (source.indptr, source.indices, np.ascontiguousarray(source.data[:, 0]), term_ptr, term_row, w,
-            source.num_cols, _work_items(nrows), *base_args)
+            source.num_cols, work_items(nrows), *base_args)
     return SparseRows(*_count_then_fill(_combine, args, nrows, w.shape[1]), source.num_cols)
 
 
@@ -204,5 +205,5 @@ def difference_rows(a: SparseRows, a_row: np.ndarray, b: SparseRows) -> SparseRo
     nrows = len(a_row)
     nc = a.num_components
     args = (a.indptr, a.indices, np.ascontiguousarray(a.data), a_row, b.indptr, b.indices,
-            np.ascontiguousarray(b.data), a.num_cols, _work_items(nrows))
+            np.ascontiguousarray(b.data), a.num_cols, work_items(nrows))
     return SparseRows(*_count_then_fill(_difference, args, nrows, nc), a.num_cols)

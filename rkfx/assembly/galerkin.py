@@ -14,7 +14,7 @@ import numba
 import numpy as np
 import scipy.sparse as sp
 
-from rkfx.approximation.sparse_rows import ITEMS_PER_THREAD, SparseRows
+from rkfx.approximation.sparse_rows import SparseRows, work_items
 
 
 @numba.njit(parallel=True, cache=True)
@@ -82,7 +82,7 @@ def elastic_stiffness(rows: SparseRows, weights: np.ndarray, d: np.ndarray) -> s
     np.cumsum(np.bincount(idx, minlength=n), out=t_ptr[1:])
     args = (rows.indptr, idx, np.ascontiguousarray(rows.data, dtype=np.float64), point_of, t_ptr, t_entry,
             np.ascontiguousarray(weights, dtype=np.float64), d, per_point, n,
-            max(1, min(n, ITEMS_PER_THREAD * numba.get_num_threads())))
+            work_items(n))
     node_ptr = np.zeros(n + 1, np.int64)
     _stiffness(*args, node_ptr, np.empty(0, np.int32), np.empty(0), False)
     np.cumsum(node_ptr, out=node_ptr)

@@ -14,6 +14,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from rkfx.errors import InputError
+from rkfx.parallel.unknowns import RowSystem
 
 
 class _ScipyLU:
@@ -72,8 +73,6 @@ def linear_solver(a: sp.spmatrix, comm=None, solver: str = "mumps", mumps_icntl:
     rigid-body modes of ``cg-gamg`` (see ``rkfx.linalg.petsc.make_ksp``)."""
     if solver == "serial":
         return _ScipyLU(a)
-    from rkfx.parallel.unknowns import RowSystem  # noqa: PLC0415
-
     if isinstance(a, RowSystem):
         try:
             return _RowSystemSolver(a, comm if comm is not None else a.share.comm, solver, mumps_icntl)

@@ -255,7 +255,8 @@ def biot_operators(p: Particles, rk: RKApproximation, domains: NodalDomains, mat
             row_nodes.append(owner)
     h = np.sqrt(d.area)
     if nodes is not None:  # the other nodes' cells may be partial (domains built around ``nodes``)
-        h = np.where(np.isin(np.arange(n), mine), h, 1.0)
+        h = np.ones(n)
+        h[mine] = np.sqrt(d.area[mine])
     return BiotOperators(kuu, kup, ks, kh, rows, weights, row_nodes, h)
 
 

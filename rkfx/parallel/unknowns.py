@@ -27,7 +27,7 @@ import scipy.sparse as sp
 from rkfx.errors import InputError
 from rkfx.parallel.halo import Halo, halo
 from rkfx.parallel.ownership import Numbering
-from rkfx.parallel.rows import owned_block
+from rkfx.parallel.rows import owned_block, renumbered
 
 
 @dataclass(frozen=True)
@@ -170,16 +170,14 @@ def row_system(contribution: sp.spmatrix, share: UnknownShare, extra: int, comm)
         comm: The communicator. Collective.
     """
     n = share.num_local
-    a = sp.coo_matrix(contribution)
-    if a.shape != (n + extra, n + extra):
-        raise InputError(f"row_system: the matrix is {a.shape}, the local unknowns {n} + {extra}")
+    if contribution.shape != (n + extra, n + extra):
+        raise InputError(f"row_system: the matrix is {contribution.shape}, the local unknowns {n} + {extra}")
     sizes = np.array(comm.allgather(share.num_owned + int(extra)), np.int64)
     starts = np.r_[0, np.cumsum(sizes)]
     glob = np.r_[starts[share.owner] + share.ordinal, starts[comm.rank] + share.num_owned + np.arange(extra)]
-    total = int(starts[-1])
-    whole = sp.csr_matrix((a.data, (glob[a.row], glob[a.col])), shape=(total, total))
     rows = np.r_[share.owned, n + np.arange(extra)]
-    return RowSystem(owned_block(whole, starts, comm), rows, share, n + int(extra))
+    return RowSystem(owned_block(renumbered(contribution, glob, int(starts[-1])), starts, comm), rows, share,
+                     n + int(extra))
 
 
 @dataclass(frozen=True)

@@ -53,7 +53,7 @@ import scipy.sparse as sp
 
 from rkfx.errors import InputError
 from rkfx.linalg.linear_solver import linear_solver
-from rkfx.solvers.checkpoint import EACH_RANK, copy_into, load_arrays, rank_folder, restore_run, save_run
+from rkfx.solvers.checkpoint import RankFiles, copy_into, restore_run, save_run
 from rkfx.solvers.fields import FieldLayout, single
 from rkfx.solvers.model import Constraints, no_constraints
 
@@ -496,12 +496,10 @@ class Workspace:
         """Energies of this rank's unknowns summed over the ranks (as is on one)."""
         return values if self.share is None else np.asarray(self.share.sum(values), float)
 
-    def folder(self, directory: str | Path | None) -> Path | None:
-        """This rank's checkpoint folder in ``directory``: itself on one rank, else
-        ``rank<r>-of-<P>/`` (``rkfx.solvers.checkpoint.rank_folder``)."""
-        if directory is None or self.share is None or self.share.size == 1:
-            return None if directory is None else Path(directory)
-        return rank_folder(directory, self.share.rank, self.share.size)
+    @property
+    def files(self) -> RankFiles:
+        """Where this process keeps its checkpoints (one per rank on several ranks)."""
+        return RankFiles(self.share)
 
 
 @dataclass(frozen=True)
@@ -595,10 +593,10 @@ class CentralDifference:
         hist_t = np.empty(num_steps + 1)
         hist_e = np.empty((num_steps + 1, len(ENERGIES)))
         resumed = None
-        checkpoint_dir = work.folder(checkpoint_dir)
-        writer = None if work.share is None or work.share.size == 1 else EACH_RANK
+        files = work.files
+        checkpoint_dir = files.folder(checkpoint_dir)
         if resume is not None:
-            ck = load_arrays(work.folder(resume), common=None if writer is None else work.share.least)
+            ck = files.load(resume)
             if ck["d"].shape != (n,) or float(ck["dt"]) != dt:
                 raise InputError(f"checkpoint in {str(resume)!r} has {ck['d'].size} unknowns and dt = "
                                  f"{float(ck['dt']):.6g}; this problem has {n} and dt = {dt:.6g}")
@@ -632,7 +630,7 @@ class CentralDifference:
             if checkpoint_every and done % checkpoint_every == 0:
                 save_run(checkpoint_dir, s.arrays(dt) | {"history_time": hist_t[:done + 1],
                                                          "history_energy": hist_e[:done + 1]}, model, recorder,
-                         comm=writer)
+                         comm=files.writer)
         wall = _time.perf_counter() - t_wall
         final = ExplicitState(num_steps, num_steps * dt, s.d, s.v, s.a, s.f_int.copy(), s.f_ext.copy(), s.energy)
         return ExplicitResult(final, dt, hist_t, hist_e, snapshots, resumed, wall)

@@ -38,6 +38,31 @@ def rank_folder(directory: str | Path, rank: int, size: int) -> Path:
     return Path(directory) / f"rank{rank}-of-{size}"
 
 
+class RankFiles:
+    """Where one process of a run keeps its checkpoints.
+
+    A model whose ``share`` (``rank``, ``size``, ``least``) splits it over several MPI ranks
+    keeps one checkpoint per rank in ``rank<r>-of-<P>/`` and resumes from the newest step all
+    ranks hold; any other run keeps one checkpoint in the folder itself, written by rank 0 of
+    ``comm`` (``writes``).
+    """
+
+    def __init__(self, share=None, comm=None):
+        self.share = share
+        self.per_rank = share is not None and share.size > 1
+        self.writer = EACH_RANK if self.per_rank else comm
+
+    def folder(self, directory: str | Path | None) -> Path | None:
+        """This process's checkpoint folder in ``directory`` (``None`` stays ``None``)."""
+        if directory is None:
+            return None
+        return rank_folder(directory, self.share.rank, self.share.size) if self.per_rank else Path(directory)
+
+    def load(self, directory: str | Path) -> dict[str, np.ndarray]:
+        """``load_arrays`` of this process's folder in ``directory`` (collective on ranks)."""
+        return load_arrays(self.folder(directory), common=self.share.least if self.per_rank else None)
+
+
 def _ranks_of(folder: Path) -> int | None:
     """P of a ``rank<r>-of-<P>`` folder, else ``None``."""
     head, sep, size = folder.name.rpartition("-of-")

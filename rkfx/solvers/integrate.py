@@ -20,7 +20,7 @@ import numpy as np
 
 from rkfx.errors import InputError
 from rkfx.linalg.linear_solver import Factorizations
-from rkfx.solvers.checkpoint import EACH_RANK, load_arrays, rank_folder, restore_run, prefixed, save_run, unprefixed
+from rkfx.solvers.checkpoint import RankFiles, restore_run, prefixed, save_run, unprefixed
 from rkfx.solvers.model import Model
 from rkfx.solvers.newmark import Newmark, StepState
 
@@ -130,15 +130,9 @@ def integrate(stepper: Newmark, model: Model, times: Sequence[float], *, start: 
     solves = Factorizations(comm, solver) if own else solves
     made = solves.count
     resumed = None
-    share = getattr(model, "share", None)
-    per_rank = share is not None and share.size > 1
-    writer = EACH_RANK if per_rank else comm
-
-    def folder(directory):
-        return rank_folder(directory, share.rank, share.size) if per_rank else directory
-
+    files = RankFiles(getattr(model, "share", None), comm)
     if resume is not None:
-        ck = load_arrays(folder(resume), common=share.least if per_rank else None)
+        ck = files.load(resume)
         s = StepState.from_arrays(unprefixed(ck, "state__"))
         if s.x.shape != (model.layout.size,):
             raise InputError(f"checkpoint in {str(resume)!r} has {s.x.size} unknowns; this model has "
@@ -183,7 +177,7 @@ def integrate(stepper: Newmark, model: Model, times: Sequence[float], *, start: 
             if recorder is not None:
                 recorder.record(s)
             if checkpoint_every and (k % checkpoint_every == 0 or k == len(t_all) - 1):
-                save_run(folder(checkpoint_dir), prefixed(s.arrays(), "state__"), model, recorder, writer)
+                save_run(files.folder(checkpoint_dir), prefixed(s.arrays(), "state__"), model, recorder, files.writer)
     finally:
         made = solves.count - made
         if own:
