@@ -36,7 +36,7 @@ import dolfinx
 import dolfinx.fem
 import dolfinx.mesh
 
-from rkfx.conditions import NATURAL, Condition, split, values
+from rkfx.conditions import NATURAL, Condition, Region, split, values
 from rkfx.errors import InputError
 
 __all__ = ["SIDES", "BoundaryParts", "Part", "at_points", "check_kinds"]
@@ -167,6 +167,9 @@ class BoundaryParts:
                              f"box {list(SIDES)}, or give a marker x -> bool with x of shape (m, {self.gdim})")
         if isinstance(part, (int, np.integer)) and not isinstance(part, bool):
             return self._tagged(part, int(part))
+        if isinstance(part, Region):
+            raise InputError(f"region {part.name!r} lies inside the domain; the FEM baselines prescribe values on "
+                             "boundary facets only: give a boundary part (name, tag or marker)")
         raise InputError(f"boundary part {part!r}: give a name (str), a facet tag (int) or a marker x -> bool "
                          f"with x of shape (m, {self.gdim})")
 

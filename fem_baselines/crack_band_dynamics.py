@@ -79,6 +79,7 @@ import ufl
 
 from rkfx.fracture import damage as dm
 from rkfx.errors import InputError
+from rkfx.geometry.gmsh_nodes import scratch_model
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.assembly.smeared_strain import dilatational_wave_speed
 from rkfx.models.damage_dynamics import DamageRun, run_damage
@@ -199,43 +200,34 @@ def cracked_plate_mesh(h: float, *, width: float = 0.1, height: float = 0.1, a1:
     """
     _check_geometry(h, width, height, a1, a2)
     side = max(width, height)
-    started = gmsh.isInitialized()
-    if not started:
-        gmsh.initialize(interruptible=False)
-    gmsh.option.setNumber("General.Terminal", 0)
-    try:
-        gmsh.model.add("slit_plate")
-        try:
-            occ = gmsh.model.occ
-            square = occ.addRectangle(0.0, 0.0, 0.0, width, height)
-            slit = occ.addLine(occ.addPoint(0.0, a2, 0.0), occ.addPoint(a1, a2, 0.0))
-            occ.fragment([(2, square)], [(1, slit)])
-            occ.synchronize()
-            tol = 1e-4 * side   # OpenCASCADE pads bounding boxes
-            curves = [t for _, t in gmsh.model.getEntities(1)
-                      if _box_on_slit(gmsh.model.getBoundingBox(1, t), a1, a2, tol)]
-            mouth = [t for _, t in gmsh.model.getEntities(0)
-                     if np.allclose(gmsh.model.getValue(0, t, []), [0.0, a2, 0.0], atol=tol)]
-            if len(curves) != 1 or len(mouth) != 1:
-                raise RuntimeError(f"gmsh did not embed the slit (curves {curves}, mouth {mouth})")
-            gmsh.model.addPhysicalGroup(2, [t for _, t in gmsh.model.getEntities(2)], 1, name="plate")
-            gmsh.model.addPhysicalGroup(1, curves, 2, name="slit")
-            gmsh.model.addPhysicalGroup(0, mouth, 3, name="mouth")
-            gmsh.option.setNumber("Mesh.MeshSizeMin", h)
-            gmsh.option.setNumber("Mesh.MeshSizeMax", h)
-            gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-            gmsh.model.mesh.generate(2)
-            gmsh.plugin.setNumber("Crack", "Dimension", 1)
-            gmsh.plugin.setNumber("Crack", "PhysicalGroup", 2)
-            gmsh.plugin.setNumber("Crack", "OpenBoundaryPhysicalGroup", 3)
-            gmsh.plugin.run("Crack")
-            gmsh.model.mesh.renumberNodes()   # dolfinx wants contiguous node tags
-            md = dolfinx.io.gmsh.model_to_mesh(gmsh.model, MPI.COMM_SELF, 0, gdim=2)
-        finally:
-            gmsh.model.remove()
-    finally:
-        if not started:
-            gmsh.finalize()
+    with scratch_model("slit_plate"):
+        occ = gmsh.model.occ
+        square = occ.addRectangle(0.0, 0.0, 0.0, width, height)
+        slit = occ.addLine(occ.addPoint(0.0, a2, 0.0), occ.addPoint(a1, a2, 0.0))
+        occ.fragment([(2, square)], [(1, slit)])
+        occ.synchronize()
+        tol = 1e-4 * side   # OpenCASCADE pads bounding boxes
+        curves = [t for _, t in gmsh.model.getEntities(1)
+                  if _box_on_slit(gmsh.model.getBoundingBox(1, t), a1, a2, tol)]
+        mouth = [t for _, t in gmsh.model.getEntities(0)
+                 if np.allclose(gmsh.model.getValue(0, t, []), [0.0, a2, 0.0], atol=tol)]
+        if len(curves) != 1 or len(mouth) != 1:
+            raise RuntimeError(f"gmsh did not embed the slit (curves {curves}, mouth {mouth})")
+        gmsh.model.addPhysicalGroup(2, [t for _, t in gmsh.model.getEntities(2)], 1, name="plate")
+        gmsh.model.addPhysicalGroup(1, curves, 2, name="slit")
+        gmsh.model.addPhysicalGroup(0, mouth, 3, name="mouth")
+        gmsh.option.setNumber("Mesh.MeshSizeMin", h)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", h)
+        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+        gmsh.model.mesh.generate(2)
+        gmsh.plugin.setNumber("Crack", "Dimension", 1)
+        gmsh.plugin.setNumber("Crack", "PhysicalGroup", 2)
+        gmsh.plugin.setNumber("Crack", "OpenBoundaryPhysicalGroup", 3)
+        # Plugin options outlive gmsh sessions: clear those an earlier caller may have set.
+        gmsh.plugin.setNumber("Crack", "NewPhysicalGroup", 0)
+        gmsh.plugin.run("Crack")
+        gmsh.model.mesh.renumberNodes()   # dolfinx wants contiguous node tags
+        md = dolfinx.io.gmsh.model_to_mesh(gmsh.model, MPI.COMM_SELF, 0, gdim=2)
     mesh = md.mesh
     V = dolfinx.fem.functionspace(mesh, ("Lagrange", 1, (2,)))
     x = V.tabulate_dof_coordinates()[:, :2].copy()

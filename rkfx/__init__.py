@@ -25,6 +25,7 @@ data path (see docs/core.md):
     materials       constitutive laws
         elasticity       the 2-D elastic law (plane strain or stress), principal directions
         damage_law       Mazars' strain and the softening law compiled, shared by statics and dynamics
+        crack_flow       flow in damaged particles: aperture, cubic law, anisotropic permeability (ch. 5)
     fracture        the damage particle method (chapter 4)
         damage           damage points: regularization by the cell chord (4.28), trial updates
         tracking         candidate damage particles along crack segments (eq. 4.22)
@@ -34,6 +35,7 @@ data path (see docs/core.md):
         damage_bar       the damaging bar under displacement control (chapter 4)
         damage_dynamics  the damage particle method in explicit dynamics, runs kept on disk
         damage_ranks     the same over MPI ranks: each rank steps its own particles
+        hydro_damage     the u-p fields of damaged particles (chapter 5)
     solvers         fields, the model protocol, steppers, one Newton, checkpoints
     linalg          linear solves: factorizations through PETSc (``rkfx.linalg.petsc``) or SciPy
     parallel        work over MPI ranks
@@ -44,7 +46,7 @@ data path (see docs/core.md):
         ghost_counts     the halo of any partition counted serially (for the scaling model)
         ranks            serial work under MPI: rank 0 runs it, the others sleep until they get the result
         threads          numba threads per rank: each rank its share of its node's cores
-    conditions      boundary conditions: one vocabulary, values of x and t
+    conditions      boundary and region conditions: one vocabulary, values of x and t
     errors          errors naming the culprit and the fix
     warmup          compile the kernels before timing
 

@@ -1,7 +1,9 @@
 """Boundary conditions: one vocabulary for every model, RKPM and FEM alike.
 
 A condition names a boundary part and a value. The part is the name of a tagged boundary
-(``"left"``, a gmsh physical group) or a marker ``marker(x) -> bool (m,)``. The value is a
+(``"left"``, a gmsh physical group) or a marker ``marker(x) -> bool (m,)``; an essential
+condition may also hold on a ``Region``, particles anywhere in the domain (a pressurized
+notch or crack). The value is a
 number, a constant vector, or a function: ``value(x, t)`` for essential conditions and
 ``value(x, t, n)`` for tractions and fluxes, with x and the outward normals n of shape
 ``(m, gdim)`` [m] and t [s]. ``values(condition, x, t, n)`` evaluates any of them to an array with
@@ -19,7 +21,29 @@ import numpy as np
 
 from rkfx.errors import InputError
 
-Boundary = str | Callable[[np.ndarray], np.ndarray]
+
+
+@dataclass(frozen=True)
+class Region:
+    """The particles anywhere in the domain (not only on its boundary) whose coordinates
+    ``marker(x) -> bool (m,)`` accepts: where an essential condition prescribes a field inside
+    the domain, e.g. the fluid pressure in a notch or a pre-existing crack (seed 5.3).
+
+    Attributes:
+        marker: Takes x of shape ``(m, gdim)`` [m], returns a bool array of shape ``(m,)``.
+        name: How messages and reports name the region.
+    """
+
+    marker: Callable[[np.ndarray], np.ndarray]
+    name: str = "region"
+
+    def __post_init__(self):
+        if not callable(self.marker):
+            raise InputError(f"Region {self.name!r}: marker {self.marker!r} is not callable; give a function "
+                             "marker(x) -> bool (m,)")
+
+
+Boundary = str | Callable[[np.ndarray], np.ndarray] | Region
 Value = float | Sequence[float] | np.ndarray | Callable[..., Any]
 
 

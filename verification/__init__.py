@@ -8,4 +8,6 @@
                    incompressible constituents, closed form in Fourier space + quadrature
     cohesive_bar   bar under tension breaking along one crack with the linear cohesive law
                    (Wei 2018, eqs. 4.7-4.9): force and crack opening against the tip displacement
+    sneddon        opening of a pressurized straight crack in an unbounded plane (Sneddon 1946,
+                   Wei 2018 eq. 5.37)
 """

@@ -207,6 +207,12 @@ ROWS: list[Row] = [
                                     ("tracking tolerance above 1", "tol=2"), ("spacing too coarse", "h=0.01"),
                                     ("tracking radius below 1 spacing", "radius=0.5"), ("negative stabilization", "eps_p=-0.5"),
                                     ("Courant number 0", "courant=0"), ("zero density", "rho=0")]),
+    *_case_rows("sneddon", [("even particle count along the crack", "crack_particles=10"),
+                            ("spacing that does not divide the square", "c=0.35"),
+                            ("unknown crack band", "bands=wide"), ("no residual stiffness", "residual=0"),
+                            ("crack as wide as the square", "c=2"), ("no pressure", "p=0"),
+                            ("tip size above the element size", "fem_tip=0.5")]),
+    Row("too big for memory", "sneddon", ("--set", "crack_particles=9,9999")),
     # --- geometry files ---
     Row("broken .geo file", "", code="from_geo('broken.geo')", setup=_file("broken.geo", BROKEN_GEO)),
     Row(".geo file with an undefined point", "", code="from_geo('undefined.geo')",

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from rkfx.conditions import ESSENTIAL, Boundary, Condition, Displacement, Traction, values
+from rkfx.conditions import ESSENTIAL, Boundary, Condition, Displacement, Region, Traction, values
 from rkfx.errors import InputError
 from rkfx.geometry.nodal_domains import NodalDomains
 from rkfx.geometry.particles import Particles
@@ -106,7 +106,9 @@ def _part_label(boundary: Boundary) -> str:
     return repr(boundary) if isinstance(boundary, str) else f"marker {getattr(boundary, '__name__', repr(boundary))}"
 
 
-def _marked(boundary: Boundary, x: np.ndarray, what: str) -> np.ndarray:
+def _marked(boundary: Boundary, x: np.ndarray, what: str,
+            fix: str = "make it accept points on the boundary (e.g. np.isclose(x[:, 1], top)), or name a tagged part"
+            ) -> np.ndarray:
     """The marker's answer at points x, shape ``(m,)`` bool; raises if it selects none."""
     accepted = np.asarray(boundary(x))
     if accepted.shape != (len(x),):
@@ -114,8 +116,7 @@ def _marked(boundary: Boundary, x: np.ndarray, what: str) -> np.ndarray:
                          "a marker(x) takes x of shape (m, 2) and returns a bool array of shape (m,)")
     accepted = accepted.astype(bool)
     if not accepted.any():
-        raise InputError(f"boundary {_part_label(boundary)} selects no {what}; make it accept points on the "
-                         "boundary (e.g. np.isclose(x[:, 1], top)), or name a tagged part")
+        raise InputError(f"boundary {_part_label(boundary)} selects no {what}; {fix}")
     return accepted
 
 
@@ -131,8 +132,11 @@ def _tag(p: Particles, boundary: Boundary) -> int:
 
 
 def part_nodes(p: Particles, boundary: Boundary) -> np.ndarray:
-    """Sorted indices of the nodes of a boundary part: the nodes of a named part, or the
-    boundary nodes whose coordinates a marker accepts."""
+    """Sorted indices of the nodes of a boundary part: the nodes of a named part, the
+    boundary nodes whose coordinates a marker accepts, or every node a ``Region`` accepts."""
+    if isinstance(boundary, Region):
+        return np.flatnonzero(_marked(boundary.marker, p.x, f"particle of region {boundary.name!r}",
+                                      "widen the region's marker or refine the particles"))
     if callable(boundary):
         nodes = p.boundary_nodes()
         return nodes[_marked(boundary, p.x[nodes], "boundary node")]
@@ -143,6 +147,9 @@ def part_nodes(p: Particles, boundary: Boundary) -> np.ndarray:
 def part_points(p: Particles, bq: BoundaryQuadrature, boundary: Boundary) -> np.ndarray:
     """Indices of the boundary quadrature points of a part: those with the part's tag, or those
     a marker accepts."""
+    if isinstance(boundary, Region):
+        raise InputError(f"region {boundary.name!r} is inside the domain; natural conditions (tractions, fluxes) "
+                         "act on boundary parts: name a tagged part or give a marker(x)")
     if callable(boundary):
         return np.flatnonzero(_marked(boundary, bq.points, "boundary quadrature point"))
     return np.flatnonzero(bq.select([_tag(p, boundary)]))

@@ -17,4 +17,8 @@ the machine cannot hold it), see ``rkfx.cases._preflight``.
     strip_load        strip load on a consolidating half-space (seed 3.4.3), graded nodes.
     cracked_bar       damage particle method on a bar in tension (seed 4.3.1): regularized vs
                       unregularized, crack-band FEM, Gauss vs SCNI stress.
+    kalthoff          Kalthoff's impact (seed 4.3.2): dynamic mixed-mode crack growth.
+    crack_branching   a crack under tension that branches (seed 4.3.3).
+    sneddon           Sneddon's pressurized crack (seed 5.3.1): a smeared RKPM crack against the
+                      discrete FEM slit on the same fixed square.
 """

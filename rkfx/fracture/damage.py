@@ -323,6 +323,27 @@ def chord_lengths(geometry: CellGeometry, nodes: np.ndarray, normals: np.ndarray
     return total
 
 
+
+def band_widths(geometry: CellGeometry, volume: np.ndarray, nodes: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """Width L_s = V_L / A_L of the smeared crack band of each node (chapter 5: 5.12-5.13),
+    its nodal volume over the chord of its domain along the crack (``chord_lengths``).
+
+    Args:
+        geometry: From ``cell_geometry``.
+        volume: Nodal volumes V of all nodes, shape ``(num_nodes,)`` [m^2 per unit thickness].
+        nodes: Node indices, shape ``(k,)`` (distinct).
+        normals: Crack normals n_L (unit), shape ``(k, 2)``.
+
+    Returns:
+        L_s, shape ``(k,)`` [m]; a node whose chord is 0 (a degenerate cell) raises.
+    """
+    nodes = np.asarray(nodes, np.int64).reshape(-1)
+    chord = chord_lengths(geometry, nodes, normals)
+    if np.any(chord <= 0):
+        bad = int(nodes[np.argmin(chord)])
+        raise InputError(f"node {bad}: its nodal domain has no chord along the crack; check the nodal domains there")
+    return np.asarray(volume, float)[nodes] / chord
+
 # --------------------------------------------------------------------------- model and state
 
 

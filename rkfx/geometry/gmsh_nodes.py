@@ -5,12 +5,35 @@ the nodal domains; 1-D physical groups name the boundary parts. Import this modu
 where gmsh is installed (``pip install rkfx[geometry]``).
 """
 import re
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 
 from rkfx.errors import InputError
 from rkfx.geometry.particles import Particles, particles
+
+
+@contextmanager
+def scratch_model(name: str) -> Iterator:
+    """A new gmsh model named ``name`` in the caller's gmsh session, or in one opened (and closed)
+    here, with gmsh's terminal output off; the model is removed on exit. Yields ``gmsh.model``."""
+    import gmsh  # noqa: PLC0415
+
+    started = gmsh.isInitialized()
+    if not started:
+        gmsh.initialize(interruptible=False)
+    gmsh.option.setNumber("General.Terminal", 0)
+    try:
+        gmsh.model.add(name)
+        try:
+            yield gmsh.model
+        finally:
+            gmsh.model.remove()
+    finally:
+        if not started:
+            gmsh.finalize()
 
 
 def from_gmsh(model=None, comm=None) -> Particles:
