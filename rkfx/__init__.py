@@ -36,6 +36,7 @@ data path (see docs/core.md):
         damage_dynamics  the damage particle method in explicit dynamics, runs kept on disk
         damage_ranks     the same over MPI ranks: each rank steps its own particles
         hydro_damage     the u-p fields of damaged particles (chapter 5)
+        hydraulic_fracture  the coupled u-p damage model with inertia for the Newmark stepper (chapter 5)
     solvers         fields, the model protocol, steppers, one Newton, checkpoints
     linalg          linear solves: factorizations through PETSc (``rkfx.linalg.petsc``) or SciPy
     parallel        work over MPI ranks

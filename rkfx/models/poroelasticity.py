@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from rkfx.assembly.boundary import (Collocation, boundary_quadrature, collocation, part_points,
+from rkfx.assembly.boundary import (BoundaryQuadrature, Collocation, boundary_quadrature, collocation, part_points,
                                    traction_values)
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.conditions import Displacement, Flux, Pressure, Traction, values
@@ -190,6 +190,72 @@ class NodalFields:
                                  f"{' or '.join(map(str, shapes))}")
 
 
+@dataclass(frozen=True)
+class BiotIntegration:
+    """The integration points of one u-p variant.
+
+    Attributes:
+        nodal: The nodal points (SCNI or DNI) of the integrated nodes.
+        quads: ``[nodal]``, or ``[nodal, subcells]`` with the MSCNI subcell terms (3.56)-(3.59).
+        owners: The particle whose fields apply at each point of each quadrature.
+        nodes: The integrated nodes (ascending).
+        subcells: Indices of the integrated subcells, or ``None`` for all of them.
+    """
+
+    nodal: Quadrature
+    quads: list[Quadrature]
+    owners: list[np.ndarray]
+    nodes: np.ndarray
+    subcells: np.ndarray | None
+
+    def at_points(self, value, constant):
+        """A per-particle field at the points of every quadrature (``constant`` where ``None``)."""
+        return constant if value is None else [np.asarray(value, float)[o] for o in self.owners]
+
+
+def biot_integration(p: Particles, rk: RKApproximation, domains: NodalDomains, variant: str = "scni+fpp",
+                     eps_p: float = 1.0, nodes: np.ndarray | None = None) -> BiotIntegration:
+    """The integration points of ``variant`` over the domains of ``nodes`` (default all)."""
+    if variant not in VARIANTS:
+        raise InputError(f"unknown variant {variant!r}; choose one of {', '.join(VARIANTS)}")
+    d = domains
+    mine = np.arange(p.num_nodes) if nodes is None else np.asarray(nodes, np.int64)
+    if variant.startswith("scni"):
+        smoothed = smoothed_gradients(p, rk, d, subcells=True, nodes=nodes)
+        nodal = scni(p, rk, d, smoothed)
+        stab = mscni_stabilization(p, rk, d, smoothed, eps_p, with_values=True)
+        return BiotIntegration(nodal, [nodal, stab], [mine, d.subcell_node[smoothed.subcells]], mine,
+                               smoothed.subcells)
+    nodal = dni(p, rk, d, nodes=nodes)
+    subcells = np.flatnonzero(np.isin(d.subcell_node, mine)) if nodes is not None else None
+    return BiotIntegration(nodal, [nodal], [mine], mine, subcells)
+
+
+def projection_rows(rk: RKApproximation, domains: NodalDomains, integration: BiotIntegration
+                    ) -> tuple[list[SparseRows], list[np.ndarray], list[np.ndarray]]:
+    """The rows N - Pi N of the fluid pressure projection on cells (3.61) and, with the MSCNI
+    subcells, on subcells (3.62), with their weights and the node whose eps_f applies."""
+    d, it = domains, integration
+    n, mine = len(d.area), it.nodes
+    # (3.61): Pi N(x_L) = sum_C N(x_hat_C) A_C / A_L, so the cell rows are N(x_L) - Pi N(x_L).
+    sub = np.arange(len(d.subcell_node)) if it.subcells is None else it.subcells
+    owner = d.subcell_node[sub]
+    at_centroids = evaluate(rk, d.subcell_centroid[sub])
+    order = np.argsort(owner, kind="stable")
+    counts = np.bincount(owner, minlength=n)[mine]
+    ptr = np.r_[0, np.cumsum(counts)]
+    cell_rows = combine_rows(at_centroids, ptr, order, -(d.subcell_area[sub] / d.area[owner])[order],
+                             base=it.nodal.values, base_row=np.arange(len(mine)))
+    rows, weights, row_nodes = [cell_rows], [d.area[mine]], [mine]
+    if len(it.quads) > 1:
+        # (3.62): Pi N(x_hat_C) = N(x_hat_C): the subcell rows are the MSCNI value rows.
+        stab = it.quads[1]
+        rows.append(stab.values)
+        weights.append(stab.weights)
+        row_nodes.append(owner)
+    return rows, weights, row_nodes
+
+
 def biot_operators(p: Particles, rk: RKApproximation, domains: NodalDomains, material: PoroMaterial,
                    variant: str = "scni+fpp", eps_p: float = 1.0, fields: NodalFields | None = None,
                    nodes: np.ndarray | None = None) -> BiotOperators:
@@ -204,55 +270,20 @@ def biot_operators(p: Particles, rk: RKApproximation, domains: NodalDomains, mat
         nodes: Integrate over the nodal domains of these nodes only (indices, ascending: a
             rank's own nodes); the operators of a partition's parts sum to the whole ones.
     """
-    if variant not in VARIANTS:
-        raise InputError(f"unknown variant {variant!r}; choose one of {', '.join(VARIANTS)}")
     d = domains
     n = p.num_nodes
     fields = NodalFields() if fields is None else fields
     fields.check(n)
-    mine = np.arange(n) if nodes is None else np.asarray(nodes, np.int64)
-    stabilized = variant.startswith("scni")
-    if stabilized:
-        smoothed = smoothed_gradients(p, rk, d, subcells=True, nodes=nodes)
-        nodal = scni(p, rk, d, smoothed)
-        stab = mscni_stabilization(p, rk, d, smoothed, eps_p, with_values=True)
-        subcells = smoothed.subcells
-        quads, owners = [nodal, stab], [mine, d.subcell_node[subcells]]
-    else:
-        nodal = dni(p, rk, d, nodes=nodes)
-        subcells = np.flatnonzero(np.isin(d.subcell_node, mine)) if nodes is not None else None
-        quads, owners = [nodal], [mine]
-
-    def at_points(value, constant):
-        return constant if value is None else [np.asarray(value, float)[o] for o in owners]
-
-    kuu = stiffness(quads, at_points(fields.D, material.elastic.D()))
+    it = biot_integration(p, rk, d, variant, eps_p, nodes)
+    quads, nodal, mine = it.quads, it.nodal, it.nodes
+    kuu = stiffness(quads, it.at_points(fields.D, material.elastic.D()))
     # Coupling (3.57): nodal points only.
     alpha = material.alpha if fields.alpha is None else np.asarray(fields.alpha, float)[mine]
     kup = (divergence_matrix(nodal).T @ sp.diags(alpha * nodal.weights) @ nodal.values.matrix()).tocsr()
-    ks = mass(quads, at_points(fields.S, material.S)) if (material.S > 0 or fields.S is not None) \
+    ks = mass(quads, it.at_points(fields.S, material.S)) if (material.S > 0 or fields.S is not None) \
         else sp.csr_matrix((n, n))
-    kh = laplacian(quads, at_points(fields.k, material.k))
-    rows, weights, row_nodes = [], [], []
-    if variant.endswith("+fpp"):
-        # (3.61): Pi N(x_L) = sum_C N(x_hat_C) A_C / A_L, so the cell rows are N(x_L) - Pi N(x_L).
-        sub = np.arange(len(d.subcell_node)) if subcells is None else subcells
-        owner = d.subcell_node[sub]
-        at_centroids = evaluate(rk, d.subcell_centroid[sub])
-        order = np.argsort(owner, kind="stable")
-        counts = np.bincount(owner, minlength=n)[mine]
-        ptr = np.r_[0, np.cumsum(counts)]
-        cell_rows = combine_rows(at_centroids, ptr, order,
-                                 -(d.subcell_area[sub] / d.area[owner])[order],
-                                 base=nodal.values, base_row=np.arange(len(mine)))
-        rows.append(cell_rows)
-        weights.append(d.area[mine])
-        row_nodes.append(mine)
-        if stabilized:
-            # (3.62): Pi N(x_hat_C) = N(x_hat_C): the subcell rows are the MSCNI value rows.
-            rows.append(stab.values)
-            weights.append(stab.weights)
-            row_nodes.append(owner)
+    kh = laplacian(quads, it.at_points(fields.k, material.k))
+    rows, weights, row_nodes = projection_rows(rk, d, it) if variant.endswith("+fpp") else ([], [], [])
     h = np.sqrt(d.area)
     if nodes is not None:  # the other nodes' cells may be partial (domains built around ``nodes``)
         h = np.ones(n)
@@ -401,6 +432,27 @@ class _Outputs:
         self.P[...] = arrays["P"]
 
 
+def boundary_loads(p: Particles, bq: BoundaryQuadrature, tractions: Sequence[Traction], fluxes: Sequence[Flux]
+                   ) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
+    """t -> (int N^T t_bar dGamma (2 n,), -int N q_bar . n dGamma (n,)): the boundary terms of
+    F^ext (3.36) and Q^ext (3.37) on the boundary quadrature ``bq``."""
+    n = p.num_nodes
+    nb = bq.rows.matrix(0)
+    traction_points = [part_points(p, bq, tr.boundary) for tr in tractions]
+    flux_points = [part_points(p, bq, fl.boundary) for fl in fluxes]
+
+    def loads(t):
+        f = np.zeros((n, 2))
+        for tr, sel in zip(tractions, traction_points):
+            f += nb[sel].T @ (bq.weights[sel, None] * traction_values(tr, bq, sel, t))
+        q = np.zeros(n)
+        for fl, sel in zip(fluxes, flux_points):
+            q -= nb[sel].T @ (bq.weights[sel] * values(fl, bq.points[sel], t, bq.normals[sel])[:, 0])
+        return f.ravel(), q
+
+    return loads
+
+
 def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_times: Sequence[float],
                displacements: Sequence[Displacement] = (), pressures: Sequence[Pressure] = (),
                tractions: Sequence[Traction] = (), fluxes: Sequence[Flux] = (),
@@ -484,17 +536,11 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
     timings["assemble"] = time.perf_counter() - t0
     t0 = time.perf_counter()
 
-    traction_points = [part_points(p, bq, tr.boundary) for tr in tractions]
-    flux_points = [part_points(p, bq, fl.boundary) for fl in fluxes]
+    boundary = boundary_loads(p, bq, tractions, fluxes)
 
     def loads(t):
-        f = np.zeros((n, 2))
-        for tr, sel in zip(tractions, traction_points):
-            f += nb[sel].T @ (bq.weights[sel, None] * traction_values(tr, bq, sel, t))
-        q = np.zeros(n)
-        for fl, sel in zip(fluxes, flux_points):
-            q -= nb[sel].T @ (bq.weights[sel] * values(fl, bq.points[sel], t, bq.normals[sel])[:, 0])
-        return f.ravel() + f_gravity, q + q_gravity  # F^ext (3.36) and Q^ext (3.37)
+        f, q = boundary(t)
+        return f + f_gravity, q + q_gravity  # F^ext (3.36) and Q^ext (3.37)
 
     local = None
     if distributed:
