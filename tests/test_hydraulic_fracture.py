@@ -5,9 +5,10 @@ import pytest
 from rkfx.approximation.shape_functions import rk_approximation
 from rkfx.conditions import Displacement, Pressure, Region
 from rkfx.errors import InputError
+from rkfx.fracture.tracking import tracking
 from rkfx.geometry.grid_cells import grid_domains
 from rkfx.geometry.particles import graded
-from rkfx.models.hydraulic_fracture import FracturingRock, HydraulicFractureModel, initial_damage
+from rkfx.models.hydraulic_fracture import FracturingRock, HydraulicFractureModel
 from rkfx.models.poroelasticity import biot_operators, fpp_parameter
 from rkfx.solvers.integrate import integrate
 from rkfx.solvers.newmark import trapezoidal
@@ -17,7 +18,7 @@ SIDES = ("left", "right", "bottom", "top")
 ROCK = FracturingRock(2.1e11, 0.3, 3000.0, 1000.0, 0.2, 1e-8, 1e4, 2e9, 1e11, 2.7e3, 2.1e7, alpha=1.0)
 
 
-def _plate(n, c=0.1, rate=5.5e4):
+def _plate(n, c=0.1, rate=5.5e4, track=False):
     h = 1.0 / n
     xs = -0.5 + h * np.arange(n + 1)
     xs[n // 2] = 0.0
@@ -26,10 +27,9 @@ def _plate(n, c=0.1, rate=5.5e4):
     rk = rk_approximation(p.x, p.spacing, 1.5)
     notch = lambda x: (np.abs(x[:, 1]) < 1.5 * h - 1e-9) & (np.abs(x[:, 0]) <= c + 1e-9)  # noqa: E731
     model = HydraulicFractureModel(
-        p, rk, d, ROCK, displacements=[Displacement(s) for s in SIDES],
+        p, rk, d, ROCK, displacements=[Displacement(s) for s in SIDES], precracked=np.flatnonzero(notch(p.x)),
         pressures=[Pressure(Region(notch, "notch"), lambda x, t: rate * t * np.ones(len(x)))]
-        + [Pressure(s) for s in SIDES])
-    model.committed = initial_damage(model.points, np.flatnonzero(notch(p.x)), (0.0, 1.0))
+        + [Pressure(s) for s in SIDES], track=tracking(p.x, p.spacing, 0.3) if track else None)
     return p, model, notch, h
 
 
@@ -95,8 +95,9 @@ def test_jacobian_matches_finite_differences_while_damaging(jacobian):
         assert k[2 * n:, :2 * n].nnz == 0 and np.linalg.norm(fd[2 * n:]) > 0
 
 
-def test_notch_pressure_grows_a_symmetric_crack_along_the_notch():
-    p, m, notch, h = _plate(20)
+@pytest.mark.parametrize("track", [False, True])
+def test_notch_pressure_grows_a_symmetric_crack_along_the_notch(track):
+    p, m, notch, h = _plate(20, track=track)
     times = np.linspace(0.0, 1200.0, 13)
     onset = []
 
@@ -118,8 +119,9 @@ def test_notch_pressure_grows_a_symmetric_crack_along_the_notch():
     xc = p.x[cracked]
     assert len(xc) >= 4
     assert np.isclose(xc[:, 0].max(), -xc[:, 0].min())      # both wings alike
-    # Along the notch: no tracking yet, so the band is up to five rows thick (the notch has three).
-    assert np.abs(xc[:, 1]).max() < 2.0 * h + 1e-9
+    # Along the notch: tracking keeps the crack in the notch's three particle rows; without it
+    # the band grows to five.
+    assert np.abs(xc[:, 1]).max() < (1.0 if track else 2.0) * h + 1e-9
     assert np.abs(xc[:, 0]).min() > 0.1                      # ahead of the tips
     assert 500.0 < onset[0] < 1200.0                         # 2.8e7 to 6.6e7 Pa at the notch
     assert len(m.iterations) == run.substeps and max(m.iterations) <= 25
@@ -140,3 +142,22 @@ def test_unknown_jacobian_is_refused():
     p, m, notch, h = _plate(6)
     with pytest.raises(InputError, match="jacobian"):
         HydraulicFractureModel(p, m.rk, m.domains, ROCK, displacements=[Displacement("left")], jacobian="exact")
+
+
+def test_injected_fluid_is_stored_exactly():
+    """Sealed plate (no drained edge): the fluid content int (alpha div u + p / Q) of the
+    trapezoidal steps equals the volume injected, int rate dt, to round-off."""
+    xs = np.linspace(-0.5, 0.5, 13)
+    p, d = graded(xs, xs), grid_domains(xs, xs)
+    rk = rk_approximation(p.x, p.spacing, 1.5)
+    rock = FracturingRock(1e10, 0.25, 2600.0, 1000.0, 0.2, 1e-8, 1e4, 2e9, 5e10, 100.0, 1e9)  # no damage
+    centre = Region(lambda x: np.hypot(x[:, 0], x[:, 1]) < 0.1, "well")
+    rate = 2e-6  # m^2/s per second: Q(t) = rate t
+    m = HydraulicFractureModel(p, rk, d, rock, displacements=[Displacement(s) for s in SIDES],
+                               injection=(centre, lambda t: rate * t))
+    times = np.linspace(0.0, 50.0, 11)
+    run = integrate(trapezoidal(), m, times)
+    x = run.state.x
+    content = np.ones(p.num_nodes) @ (m.capacity(5.0)[2 * p.num_nodes:] @ x)
+    assert np.isclose(content, 0.5 * rate * times[-1] ** 2, rtol=1e-9)
+    assert x[2 * p.num_nodes:].max() > 0

@@ -213,6 +213,13 @@ ROWS: list[Row] = [
                             ("crack as wide as the square", "c=2"), ("no pressure", "p=0"),
                             ("tip size above the element size", "fem_tip=0.5")]),
     Row("too big for memory", "sneddon", ("--set", "crack_particles=9,9999")),
+    *_case_rows("injection", [("spacing that does not divide the notch", "h=0.03"),
+                              ("Biot coefficient below the porosity", "alpha=0.1"),
+                              ("unknown Jacobian", "jacobian=exact"), ("falling notch pressure", "rate=-1"),
+                              ("map time after the end", "t_out=5000"), ("porosity 1", "porosity=1"),
+                              ("tracking tolerance above 1", "tol=2")]),
+    Row("no FEM baseline yet", "injection", ("--method", "fem")),
+    Row("too big for memory", "injection", ("--set", "h=1e-5")),
     # --- geometry files ---
     Row("broken .geo file", "", code="from_geo('broken.geo')", setup=_file("broken.geo", BROKEN_GEO)),
     Row(".geo file with an undefined point", "", code="from_geo('undefined.geo')",

@@ -21,4 +21,6 @@ the machine cannot hold it), see ``rkfx.cases._preflight``.
     crack_branching   a crack under tension that branches (seed 4.3.3).
     sneddon           Sneddon's pressurized crack (seed 5.3.1): a smeared RKPM crack against the
                       discrete FEM slit on the same fixed square.
+    injection         fluid injection into a notched saturated plate (seed 5.3.2): hydraulic
+                      fracture by the coupled damage particle method.
 """

@@ -9,6 +9,7 @@ module may define
 Both receive every parameter of the case; neither may allocate much or start the work, so a
 refused run costs nothing and writes nothing.
 """
+import inspect
 import math
 import os
 import sys
@@ -135,7 +136,8 @@ def before_work(run: Callable, params: Mapping[str, Any], methods: Sequence[str]
         refuse_if_too_big(needed, ranks=comm.size if comm is not None else 1)
     check = getattr(module, "check", None)
     if check is not None:
-        check(**params)
+        # A check that names ``methods`` also gets them (e.g. a case without a FEM baseline).
+        check(**params, **({"methods": tuple(methods)} if "methods" in inspect.signature(check).parameters else {}))
 
 
 def support_factor_ok(support_factor: float, low: float = 1.0) -> None:

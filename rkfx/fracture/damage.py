@@ -495,7 +495,8 @@ def initiate(model: DamageModel, points: np.ndarray, effective: np.ndarray, norm
 
 
 def update(model: DamageModel, state: DamageState, strain: np.ndarray, tangent: bool = True,
-           tangent_floor: float = 0.0, loading_tolerance: float = 0.0) -> DamageUpdate:
+           tangent_floor: float = 0.0, loading_tolerance: float = 0.0,
+           allowed: np.ndarray | None = None) -> DamageUpdate:
     """Damage, stress and tangent for the strains ``strain`` from the converged ``state``.
 
     kappa = max(kappa_old, eps_eq(strain)) (4.3)-(4.5). A point crossing its threshold for the
@@ -518,6 +519,9 @@ def update(model: DamageModel, state: DamageState, strain: np.ndarray, tangent: 
             small positive value makes a point sitting on its threshold (the first iterate of
             a step, or the peak) soften in the tangent, so that Newton's first prediction
             follows the softening branch rather than the secant one.
+        allowed: Points that may damage further (particle tracking, ``rkfx.fracture.tracking``),
+            shape ``(m,)`` bool; the others keep their history and respond elastically with
+            their committed damage. ``None``: every point.
 
     A regularized kappa_c <= kappa0 (a cell too coarse for G_F) makes the point perfectly
     brittle; ``check_regularization`` rejects such converged states.
@@ -527,14 +531,17 @@ def update(model: DamageModel, state: DamageState, strain: np.ndarray, tangent: 
     c = elastic.D()
     e = np.ascontiguousarray(strain, float).reshape(-1, 3)
     m = len(e)
-    everywhere = np.ones(m, bool)
+    everywhere = np.ones(m, bool) if allowed is None else np.asarray(allowed, bool)
     eq, effective, crossing = np.empty(m), np.empty((m, 3)), np.empty(m, bool)  # crossing: unused here
     law.strain_kernel_serial(e, c, elastic.out_of_plane_ratio, everywhere, state.damaged, model.kappa0, eq,
                              effective, crossing)
-    trial = np.maximum(state.kappa, eq)
+    trial = np.maximum(state.kappa, eq) if allowed is None else np.where(everywhere, np.maximum(state.kappa, eq),
+                                                                         state.kappa)
     # Points crossing their threshold now fix n_L and kappa_c; points within the loading
     # tolerance below it get prospective values for the tangent only.
     near = ~state.damaged & (trial >= (1.0 - loading_tolerance) * model.kappa0)
+    if allowed is not None:
+        near &= everywhere
     new = near & (trial >= model.kappa0)
     normal, kappa_c, chord = state.normal, state.kappa_c, state.chord
     if near.any():
@@ -558,6 +565,8 @@ def update(model: DamageModel, state: DamageState, strain: np.ndarray, tangent: 
         tan = np.maximum(1.0 - d, tangent_floor)[:, None, None] * c
         kc_t = np.where(near, kc_tangent, kc) if near.any() else kc
         loading = (eq > (1.0 - loading_tolerance) * np.maximum(state.kappa, model.kappa0)) & (eq < kc_t)
+        if allowed is not None:
+            loading &= everywhere
         if loading.any():
             i = np.flatnonzero(loading)
             slope = damage_slope(np.maximum(eq[i], model.kappa0[i]), model.kappa0[i], kc_t[i])

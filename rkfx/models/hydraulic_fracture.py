@@ -29,19 +29,20 @@ iterations of every accepted step is kept (``iterations``).
 Pre-existing cracks (a notch) enter as particles damaged from the start (``initial_damage``):
 D = 1 with their crack normal, fluid pressure prescribed on them by a ``Region`` condition.
 """
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, fields
 
 import numpy as np
 import scipy.sparse as sp
 
 from rkfx.approximation.shape_functions import RKApproximation
-from rkfx.assembly.boundary import boundary_quadrature, collocation
+from rkfx.assembly.boundary import boundary_quadrature, collocation, part_nodes
 from rkfx.assembly.operators import laplacian, mass, stiffness, strain_matrix
 from rkfx.assembly.smeared_strain import lumped_mass, row_strains
-from rkfx.conditions import Displacement, Flux, Pressure, Traction
+from rkfx.conditions import Displacement, Flux, Pressure, Region, Traction
 from rkfx.errors import InputError
 from rkfx.fracture import damage as dm
+from rkfx.fracture.tracking import Tracking
 from rkfx.geometry.nodal_domains import NodalDomains
 from rkfx.geometry.particles import Particles
 from rkfx.materials import crack_flow
@@ -167,12 +168,26 @@ class HydraulicFractureModel:
         displacements, pressures: Essential conditions (collocated; ``Region`` pressures
             prescribe the notch).
         tractions, fluxes: Natural conditions on boundary parts.
-        start: Initial damage state (``initial_damage``), default undamaged.
+        precracked: Particles of a pre-existing crack (notch), damaged from the start
+            (``initial_damage``) across ``precrack_normal``; default none.
         residual: Least stiffness fraction 1 - D [-].
         eps_p: MSCNI subcell factor.
         jacobian: ``symmetric`` (5.36), or ``full`` with dK_H/dU P in the p-u block (5.33):
             the dependence of the crack permeability on the aperture w (5.13) through the
             smeared strain and the damage of loading particles.
+        injection: ``(region, rate)``: fluid injected into the particles of a ``Region`` at
+            ``rate(t)`` [m^3/s per unit thickness], spread over them by volume (a source in the
+            storage equation, Q^ext); the alternative to prescribing the notch pressure.
+        track: Particle tracking (``rkfx.fracture.tracking``): only its seeds, the damaged
+            particles and the candidates (4.22) of the damaged ones may damage. Within every
+            residual the particles that initiate admit their candidates at once and the
+            damage is evaluated again, until no admitted particle initiates (the crack may grow
+            by more than a tracking radius in a step). What a step's iterates admit stays
+            admitted until the step is committed: a particle strained past its threshold
+            while not allowed would otherwise damage at once in one iterate and not at all in
+            the next, and Newton would cycle between the two. The pre-cracked particles admit
+            their candidates from the start. ``None``: every
+            particle may damage.
     """
 
     linear = False
@@ -180,8 +195,10 @@ class HydraulicFractureModel:
     def __init__(self, p: Particles, rk: RKApproximation, domains: NodalDomains, rock: FracturingRock, *,
                  displacements: Sequence[Displacement] = (), pressures: Sequence[Pressure] = (),
                  tractions: Sequence[Traction] = (), fluxes: Sequence[Flux] = (),
-                 start: dm.DamageState | None = None, residual: float = RESIDUAL_STIFFNESS, eps_p: float = 1.0,
-                 jacobian: str = "symmetric"):
+                 precracked: np.ndarray | None = None, precrack_normal: Sequence[float] = (0.0, 1.0),
+                 residual: float = RESIDUAL_STIFFNESS, eps_p: float = 1.0,
+                 jacobian: str = "symmetric", track: Tracking | None = None,
+                 injection: tuple[Region, Callable[[float], float]] | None = None):
         if jacobian not in JACOBIANS:
             raise InputError(f"jacobian = {jacobian!r}; choose one of {', '.join(JACOBIANS)}")
         self.jacobian = jacobian
@@ -204,14 +221,28 @@ class HydraulicFractureModel:
         self._fpp = projection_rows(rk, domains, it)
         self._C = rock.damage_material.elasticity()
         self.points = dm.damage_model(rock.damage_material, self.volume, geometry=dm.cell_geometry(domains))
-        self.committed = dm.initial_state(self.points) if start is None else start
+        self.committed = initial_damage(self.points, np.zeros(0, np.int64) if precracked is None else precracked,
+                                        precrack_normal)
+        self.track = track if track is not None and track.enabled else None
+        self.allowed = None if self.track is None else self.track.seeds | self.committed.damaged
+        self.parent = np.full(n, -1, np.int64)
+        self._trial_tracking: tuple[np.ndarray, np.ndarray] | None = None
+        if self.track is not None:
+            self._admit(np.flatnonzero(self.committed.damaged), self.committed.normal, self.allowed, self.parent)
         self.trial: dm.DamageUpdate | None = None
         self.strain = np.zeros((n, 3))
         self._bands_width = None
         self._mass = np.r_[lumped_mass(self.volume, rock.density), np.zeros(n)]
         self._col = collocation(p, rk, [(displacements, 0, 2), (pressures, 2 * n, 1)], 3 * n)
         bq = boundary_quadrature(p, domains, rk)
-        self._loads = boundary_loads(p, bq, tractions, fluxes)
+        self._boundary_loads = boundary_loads(p, bq, tractions, fluxes)
+        self._injection = None
+        if injection is not None:
+            region, rate = injection
+            inside = part_nodes(p, region)
+            share = np.zeros(n)
+            share[inside] = self.volume[inside] / self.volume[inside].sum()
+            self._injection = (self._values.T @ share, rate)  # int N_I s dOmega per unit injected volume
         self._h = np.sqrt(domains.area)
         self._intact = rock.intact()
         self.iterations: list[int] = []
@@ -244,6 +275,18 @@ class HydraulicFractureModel:
         kfc = crack_flow.fracture_permeability(w, bands.width, self.rock.viscosity)
         return crack_flow.permeability_tensor(self.rock.mobility, kfc, bands.normal)
 
+    def pressures(self, x: np.ndarray) -> np.ndarray:
+        """p^h at the particles for the unknowns ``x`` [Pa], shape ``(n,)``."""
+        return self._values @ x[2 * self.n:]
+
+    def _loads(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """F^ext and Q^ext at t: boundary tractions and fluxes, and the injected fluid."""
+        f, q = self._boundary_loads(t)
+        if self._injection is not None:
+            weights, rate = self._injection
+            q = q + float(rate(t)) * weights
+        return f, q
+
     def _stiffness_fraction(self, damage: np.ndarray) -> np.ndarray:
         return np.maximum(1.0 - damage, self.residual_fraction)
 
@@ -265,7 +308,7 @@ class HydraulicFractureModel:
         u, P = self._split(x)
         eps = row_strains(self._grad, u)
         self.strain = eps
-        self.trial = upd = dm.update(self.points, self.committed, eps, tangent_floor=self.residual_fraction)
+        self.trial = upd = self._damage(eps)
         st = upd.state
         frac = self._stiffness_fraction(st.damage)
         stress = frac[:, None] * (eps @ self._C.T)
@@ -363,19 +406,60 @@ class HydraulicFractureModel:
         n = self.n
         return np.r_[np.ones(2 * n), np.full(n, -1.0 / co.dv[0])]
 
+    MAX_TRACKING_ROUNDS = 1000  # admissions within one residual (each admits at least one particle)
+
+    def _damage(self, eps: np.ndarray) -> dm.DamageUpdate:
+        """The trial damage of ``eps`` from the committed state, with the tracking candidates of
+        the particles initiating in it admitted until none initiates (``track``)."""
+        if self.track is None:
+            return dm.update(self.points, self.committed, eps, tangent_floor=self.residual_fraction)
+        if self._trial_tracking is None:
+            self._trial_tracking = (self.allowed.copy(), self.parent.copy())
+        allowed, parent = self._trial_tracking  # grows over the step's iterates (see ``track``)
+        upd = dm.update(self.points, self.committed, eps, tangent_floor=self.residual_fraction, allowed=allowed)
+        done = self.committed.damaged.copy()
+        for _ in range(self.MAX_TRACKING_ROUNDS):
+            new = np.flatnonzero(upd.state.damaged & ~done)
+            if new.size == 0 or not self._admit(new, upd.state.normal, allowed, parent):
+                break
+            done[new] = True
+            upd = dm.update(self.points, self.committed, eps, tangent_floor=self.residual_fraction, allowed=allowed)
+        return upd
+
+    def _admit(self, new: np.ndarray, normal: np.ndarray, allowed: np.ndarray, parent: np.ndarray) -> bool:
+        """Allow, in place, the tracking candidates (4.22) of the particles ``new`` that
+        initiated with ``normal``; whether any was not allowed before."""
+        if self.track is None or new.size == 0:
+            return False
+        cand, by = self.track.candidates(new, normal[new], parent)
+        fresh = ~allowed[cand]
+        allowed[cand] = True
+        parent[cand[fresh]] = by[fresh]
+        return bool(fresh.any())
+
     def commit(self) -> None:
         self.committed = self.trial.state
+        if self.track is not None and self._trial_tracking is not None:
+            self.allowed, self.parent = self._trial_tracking
+        self._trial_tracking = None
         dm.check_regularization(self.points, self.committed)
         self.iterations.append(self._count)
         self._count = 0
 
     def state(self) -> dict[str, np.ndarray]:
-        return {f.name: getattr(self.committed, f.name) for f in fields(dm.DamageState)} | {
-            "iterations": np.array(self.iterations, np.int64)}
+        out = {f.name: getattr(self.committed, f.name) for f in fields(dm.DamageState)} | {
+            "iterations": np.array(self.iterations, np.int64), "parent": self.parent}
+        if self.allowed is not None:
+            out["allowed"] = self.allowed
+        return out
 
     def restore(self, arrays) -> None:
         self.committed = dm.DamageState(**{f.name: np.array(arrays[f.name]) for f in fields(dm.DamageState)})
         self.iterations = [int(i) for i in arrays["iterations"]]
+        self.parent = np.array(arrays["parent"], np.int64)
+        if self.allowed is not None:
+            self.allowed = np.array(arrays["allowed"], bool)
+        self._trial_tracking = None
 
 
 def _unit(normal: np.ndarray) -> np.ndarray:

@@ -1,0 +1,372 @@
+"""Fluid injection into a notched, saturated plate: hydraulic fracture by the coupled damage particle method (seed 5.3.2).
+
+Problem (Fig 5.5-5.7, after Ehlers and Luo 2017). The plate [-L/2, L/2]^2 (L = 1 m), plane
+strain, saturated, with a central notch 2c = 0.2 m along x. The notch carries the fluid
+pressure p_bar = 5.5e4 t Pa (``rate`` t). Rock: E = 2.1e11 Pa, nu = 0.3, rho_s = 3000,
+rho_w = 1000 kg/m^3, n_f = 0.2, k_h = 1e-8 m/s, gamma_w = 1e4 Pa/m, K_w = 2e9 Pa,
+K_s = 1e11 Pa, G_F = 2.7e3 N/m, f_t = 2.1e7 Pa, fluid viscosity 1e-3 Pa s (the cubic law).
+
+Boundary conditions. The outer edges are drained, p = 0 (the flow runs to them, Fig 5.7), and
+fixed, u = 0: the seed does not state the mechanical condition; a fixed frame takes the rigid
+motions out without singling out an edge, keeps the problem symmetric about both axes (the
+wings must match), and is the condition of the Sneddon case, whose smeared notch this plate
+reuses.
+
+Biot coefficient. With these moduli the skeleton's bulk modulus K = E / (3 (1 - 2 nu)) =
+1.75e11 Pa exceeds K_s, so 1 - (1 - D) K / K_s would be negative; the run takes alpha = 1
+(``alpha``) and 1/Q = n_f / K_w + (alpha - n_f) / K_s.
+
+Model (``rkfx.models.hydraulic_fracture``). A square grid of particles of spacing h (a row on
+the notch, ``h`` list of refinements, each dividing c and L/2), rectangular SCNI cells with the
+MSCNI subcells, support 1.5 h. The notch is smeared like Sneddon's crack (``rkfx.cases.sneddon``,
+band ``strip``): D = 1 at the particles within 1.5 h of its line with |x| <= c, normal (0, 1),
+and the notch pressure prescribed on them (a ``Region`` condition). Crack growth: Mazars'
+strain, linear softening regularized by the cell chord (4.28), particle tracking (4.22) with
+``tol`` within ``radius`` h seeded by the notch particles. The trapezoidal rule (5.18)-(5.24) with
+steps of ``dt`` and Newton with the ``jacobian`` (``full`` with dK_H/dU, or the symmetrized
+(5.36)); a step whose Newton fails is cut in halves.
+
+Reported per run: the crack's tips and length against time (the outermost cracked cells,
+w / w_c >= 0.5), the onset of propagation (the first step with a cracked particle outside the
+notch: time and notch pressure) beside a strength estimate (p_bar = f_t) and an LEFM estimate
+(p_bar sqrt(pi c) = sqrt(E G_F / (1 - nu^2))), the wings' asymmetry, Newton iterations per
+step, the pressure and damage maps at ``t_out`` (Fig 5.6) and the Darcy velocity q = -k_f grad p
+at the end (Fig 5.7). Between the two finest runs: the relative L2 difference of p on a common
+sample grid and the crack lengths at t_end.
+
+There is no FEM baseline yet (the crack-band u-p FEM is to come): ``--method fem`` is refused,
+``both`` runs RKPM and says so.
+
+Parameters (``--set NAME=VALUE``, SI units): E, nu, rho_s, rho_w, porosity, k_h, gamma_w, K_w,
+K_s, GF, ft, viscosity, alpha, L, c, rate, t_end, dt, t_out, h, tol, radius, jacobian,
+support_factor. Long runs: ``--checkpoint-every N`` and ``--resume DIR``.
+
+    python -m rkfx.cases.injection [--quick] [--method rkpm|both] [--set NAME=VALUE] [--out DIR]
+"""
+import math
+import sys
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from rkfx.approximation.shape_functions import evaluate, rk_approximation
+from rkfx.cases import _cli, _preflight
+from rkfx.cases._cli import Param, Results, Run
+from rkfx.conditions import Displacement, Pressure, Region
+from rkfx.errors import InputError
+from rkfx.fracture import damage as dm
+from rkfx.fracture.tracking import check_tracking, tracking
+from rkfx.geometry.grid_cells import grid_domains
+from rkfx.geometry.particles import graded
+from rkfx.models.hydraulic_fracture import JACOBIANS, FracturingRock, HydraulicFractureModel
+from rkfx.solvers.integrate import integrate
+from rkfx.solvers.newmark import trapezoidal
+from rkfx.solvers.newton import NewtonOptions
+
+NAME = "injection"
+SIDES = ("left", "right", "bottom", "top")
+CRACKED = 0.5          # w / w_c from which a particle counts as cracked (as in chapter 4)
+SAMPLES = 101          # common sample grid of p per side (refinement differences, maps)
+MAP_MAX = 200          # at most this many particles per side on the damage maps
+ARROWS = 25            # Darcy arrows per side
+RKPM_BYTES_PER_NODE = 60e3  # as the Sneddon case (same operators, plus the damage history)
+
+PARAMS = {
+    "E": Param(2.1e11, "Young's modulus [Pa]"),
+    "nu": Param(0.3, "Poisson's ratio [-]"),
+    "rho_s": Param(3000.0, "grain density [kg/m^3]"),
+    "rho_w": Param(1000.0, "fluid density [kg/m^3]"),
+    "porosity": Param(0.2, "porosity n_f [-]"),
+    "k_h": Param(1e-8, "hydraulic conductivity [m/s]"),
+    "gamma_w": Param(1e4, "specific weight of the fluid [Pa/m]"),
+    "K_w": Param(2e9, "fluid bulk modulus [Pa]"),
+    "K_s": Param(1e11, "grain bulk modulus [Pa]"),
+    "GF": Param(2.7e3, "fracture energy [N/m]"),
+    "ft": Param(2.1e7, "tensile strength [Pa]"),
+    "viscosity": Param(1e-3, "fluid viscosity [Pa s] (cubic law 5.12)"),
+    "alpha": Param(1.0, "Biot coefficient [-] (K > K_s here: see the docstring)"),
+    "L": Param(1.0, "side of the plate [m]"),
+    "c": Param(0.1, "half-length of the notch [m]"),
+    "rate": Param(5.5e4, "notch pressure rate: p_bar = rate t [Pa/s]"),
+    "t_end": Param(4000.0, "end time [s]"),
+    "dt": Param(50.0, "time step [s]"),
+    "t_out": Param([1000.0, 2000.0, 3000.0, 4000.0], "times of the pressure and damage maps [s]"),
+    "h": Param([5e-3, 2.5e-3], "particle spacings of the refinements [m]", fingerprint=False),
+    "tol": Param(0.3, "tracking tolerance of (4.22) [-]"),
+    "radius": Param(3.5, "tracking radius [spacings]"),
+    "jacobian": Param("full", "Newton's Jacobian: full (with dK_H/dU) or symmetric (5.36)"),
+    "support_factor": Param(1.5, "RK support radius / spacing [-]"),
+    "max_cuts": Param(12, "halvings of a step whose Newton fails before the run stops [-]"),
+}
+QUICK = {"h": [0.05, 0.025], "dt": 100.0, "t_end": 2000.0, "t_out": [1000.0, 2000.0]}
+
+
+def _intervals(length: float, h: float) -> int:
+    return int(round(length / h))
+
+
+def check(*, L, c, h, dt, t_end, t_out, tol, radius, jacobian, support_factor, rate, max_cuts=12,
+          methods=("rkpm",), **material) -> None:
+    """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
+    if "rkpm" not in methods:
+        raise InputError("the injection case has no FEM baseline yet (the crack-band u-p FEM is to come); "
+                         "use --method rkpm")
+    _rock(**{k: material[k] for k in ("E", "nu", "rho_s", "rho_w", "porosity", "k_h", "gamma_w", "K_w", "K_s",
+                                      "GF", "ft", "viscosity", "alpha")})
+    if not (L > 0 and 0 < c < L / 2):
+        raise InputError(f"c = {c!r}: the notch's half-length must lie in (0, L/2) = (0, {L / 2:g})")
+    for hh in h:
+        n, m = _intervals(L, hh), _intervals(c, hh)
+        if not (hh > 0 and abs(n * hh - L) < 1e-9 * L and abs(m * hh - c) < 1e-9 * L and n % 2 == 0 and m >= 2):
+            raise InputError(f"h: {hh!r} must divide c = {c:g} (at least twice) and L / 2 = {L / 2:g}; e.g. "
+                             f"h = {c / 20:g}")
+    if not (dt > 0 and t_end >= dt):
+        raise InputError(f"dt = {dt!r}, t_end = {t_end!r}: need 0 < dt <= t_end")
+    if any(not 0 < t <= t_end for t in t_out):
+        raise InputError(f"t_out = {list(t_out)!r}: map times must lie in (0, t_end]")
+    if rate <= 0:
+        raise InputError(f"rate = {rate!r}: the notch pressure must rise (rate > 0)")
+    if int(max_cuts) != max_cuts or max_cuts < 0:
+        raise InputError(f"max_cuts = {max_cuts!r} must be a whole number >= 0")
+    if jacobian not in JACOBIANS:
+        raise InputError(f"jacobian = {jacobian!r}; choose one of {', '.join(JACOBIANS)}")
+    check_tracking(tol, radius)
+    _preflight.support_factor_ok(support_factor)
+
+
+def memory_need(methods, *, L, h, **_) -> _preflight.Need:
+    """Peak memory of the finest run (see ``rkfx.cases._preflight``)."""
+    nodes = max((_intervals(L, hh) + 1) ** 2 for hh in h)
+    return _preflight.need(RKPM_BYTES_PER_NODE, nodes, f"h={min(h):g}", "raise h")
+
+
+def _rock(**m) -> FracturingRock:
+    return FracturingRock(m["E"], m["nu"], m["rho_s"], m["rho_w"], m["porosity"], m["k_h"], m["gamma_w"], m["K_w"],
+                          m["K_s"], m["GF"], m["ft"], m["viscosity"], m["alpha"])
+
+
+def onset_estimates(rock: FracturingRock, c: float, rate: float) -> dict:
+    """Notch pressure and time of the onset of propagation by strength (p_bar = f_t) and by LEFM
+    (K_I = p_bar sqrt(pi c) = K_Ic = sqrt(E G_F / (1 - nu^2)))."""
+    k_ic = math.sqrt(rock.E * rock.GF / (1.0 - rock.nu**2))
+    p_lefm = k_ic / math.sqrt(math.pi * c)
+    return {"p_strength": rock.ft, "t_strength": rock.ft / rate, "K_Ic": k_ic, "p_lefm": p_lefm,
+            "t_lefm": p_lefm / rate}
+
+
+class _Record:
+    """Per committed step: crack tips, cracked count; at the map times: p on the sample grid,
+    damage at the map particles."""
+
+    def __init__(self, model: HydraulicFractureModel, h: float, notch: np.ndarray, t_out, samples, shown):
+        self.model, self.h, self.notch, self.t_out = model, h, notch, np.asarray(t_out, float)
+        self.sample_rows = evaluate(model.rk, samples).matrix()
+        self.shown = shown
+        self.rows = {k: [] for k in ("t", "left", "right", "cracked", "iterations", "notch_p")}
+        self.centre = int(np.argmin(np.hypot(model.p.x[:, 0], model.p.x[:, 1])))
+        self.maps = {"t": [], "p": [], "damage": []}
+        self._seen = 0  # substeps of the model already counted
+
+    def opening(self) -> np.ndarray:
+        st, pts = self.model.committed, self.model.points
+        return dm.crack_opening(st.kappa, pts.kappa0, st.kappa_c)
+
+    def record(self, s) -> None:
+        m = self.model
+        x = m.p.x
+        cracked = self.opening() >= CRACKED
+        left = x[cracked, 0].min() - 0.5 * self.h if cracked.any() else 0.0
+        right = x[cracked, 0].max() + 0.5 * self.h if cracked.any() else 0.0
+        spent = sum(m.iterations[self._seen:])  # the grid step's substeps, failed attempts included
+        self._seen = len(m.iterations)
+        for key, v in (("t", s.t), ("left", left), ("right", right), ("cracked", int((cracked & ~self.notch).sum())),
+                       ("iterations", spent), ("notch_p", float(self.sample_centre(s)))):
+            self.rows[key].append(v)
+        if np.any(np.isclose(self.t_out, s.t, rtol=1e-12, atol=1e-9)):
+            P = s.x[2 * m.n:]
+            self.maps["t"].append(s.t)
+            self.maps["p"].append(self.sample_rows @ P)
+            self.maps["damage"].append(m.committed.damage[self.shown])
+
+    def sample_centre(self, s) -> float:
+        """p^h at the notch's centre particle [Pa]."""
+        return float(self.model.pressures(s.x)[self.centre])
+
+    def arrays(self):
+        return {**{f"row_{k}": np.array(v) for k, v in self.rows.items()},
+                **{f"map_{k}": np.array(v) for k, v in self.maps.items()}}
+
+    def restore(self, a) -> None:
+        self.rows = {k: list(a[f"row_{k}"]) for k in self.rows}
+        self.maps = {k: list(a[f"map_{k}"]) for k in self.maps}
+        self._seen = len(self.model.iterations)
+
+
+def solve(h: float, *, L, c, rate, t_end, dt, t_out, tol, radius, jacobian, support_factor, rock, max_cuts=12,
+          io=None, comm=None) -> dict:
+    """One refinement: the crack history, maps and Darcy velocity (see the module docstring)."""
+    t0 = time.perf_counter()
+    N = _intervals(L, h)
+    xs = -L / 2 + h * np.arange(N + 1)
+    xs[N // 2] = 0.0
+    p = graded(xs, xs)
+    domains = grid_domains(xs, xs)
+    rk = rk_approximation(p.x, p.spacing, support_factor)
+    tol_x = 1e-9 * L
+
+    def in_notch(x):
+        return (np.abs(x[:, 1]) < support_factor * h - tol_x) & (np.abs(x[:, 0]) <= c + tol_x)
+
+    notch = in_notch(p.x)
+    model = HydraulicFractureModel(
+        p, rk, domains, rock, displacements=[Displacement(s) for s in SIDES],
+        pressures=[Pressure(Region(in_notch, "notch"), lambda x, t: np.full(len(x), rate * t))]
+        + [Pressure(s) for s in SIDES], precracked=np.flatnonzero(notch), jacobian=jacobian,
+        track=tracking(p.x, p.spacing, tol, seeds=notch, radius=radius))
+    g = np.linspace(-L / 2, L / 2, SAMPLES)
+    samples = np.column_stack([np.repeat(g, SAMPLES), np.tile(g, SAMPLES)])  # x slow, y fast
+    step = max(1, int(math.ceil((N + 1) / MAP_MAX)))
+    keep = np.arange(0, N + 1, step)
+    shown = (keep[:, None] * (N + 1) + keep[None, :]).ravel()  # row j (y), column i (x): j (N+1) + i
+    rec = _Record(model, h, notch, t_out, samples, shown)
+    times = np.unique(np.r_[np.arange(0.0, t_end, dt), t_end, np.asarray(t_out, float)])
+    io = io or {}
+    # Backtracking: near the damage threshold the loading set of the tangent can flip between
+    # two iterates and plain Newton cycles between them.
+    run = integrate(trapezoidal(newton=NewtonOptions(line_search=True)), model, times, recorder=rec, comm=comm, max_cuts=max_cuts,
+                    progress=lambda it: _cli.progress(it, f"h={h:g}", len(times) - 1), **io)
+    # Darcy velocity at the end: q = -k_f grad p at the particles.
+    P = run.state.x[2 * model.n:]
+    grad = np.column_stack([model.nodal.gradients.matrix(0) @ P, model.nodal.gradients.matrix(1) @ P])
+    k = model.permeability(model.committed, model.strain)
+    q = -np.einsum("nij,nj->ni", k, grad)
+    arrows = np.arange(0, N + 1, max(1, N // ARROWS))
+    arrow_nodes = (arrows[:, None] * (N + 1) + arrows[None, :]).ravel()
+    cracked = rec.opening() >= CRACKED
+    qn = np.hypot(q[:, 0], q[:, 1])
+    notch_p = np.asarray(rec.rows["notch_p"])
+    return {"rec": rec, "h": h, "notch_p": notch_p, "nodes": p.num_nodes, "n_dofs": 3 * p.num_nodes, "wall": time.perf_counter() - t0,
+            "steps": run.steps, "substeps": run.substeps, "cuts": run.cuts, "newton": run.newton_iterations,
+            "iterations": list(model.iterations), "x_shown": p.x[shown], "shape": (len(keep), len(keep)),
+            "arrow_x": p.x[arrow_nodes], "arrow_q": q[arrow_nodes], "q_max_cracked": float(qn[cracked].max()),
+            "q_max_intact": float(qn[~cracked].max()), "damaged": int(model.committed.damaged.sum())}
+
+
+def run(*, methods: Sequence[str] = ("rkpm",), E=2.1e11, nu=0.3, rho_s=3000.0, rho_w=1000.0, porosity=0.2,
+        k_h=1e-8, gamma_w=1e4, K_w=2e9, K_s=1e11, GF=2.7e3, ft=2.1e7, viscosity=1e-3, alpha=1.0, L=1.0, c=0.1,
+        rate=5.5e4, t_end=4000.0, dt=50.0, t_out=(1000.0, 2000.0, 3000.0, 4000.0), h=(5e-3, 2.5e-3), tol=0.3,
+        radius=3.5, jacobian="full", support_factor=1.5, max_cuts=12, checkpoint_every=0, work_dir=None, resume=None) -> Results:
+    """Every refinement; see the module docstring."""
+    material = dict(E=E, nu=nu, rho_s=rho_s, rho_w=rho_w, porosity=porosity, k_h=k_h, gamma_w=gamma_w, K_w=K_w,
+                    K_s=K_s, GF=GF, ft=ft, viscosity=viscosity, alpha=alpha)
+    setup = dict(L=L, c=c, rate=rate, t_end=t_end, dt=dt, t_out=list(t_out), tol=tol, radius=radius,
+                 jacobian=jacobian, support_factor=support_factor, max_cuts=max_cuts)
+    check(h=list(h), methods=tuple(methods), **setup, **material)
+    if "fem" in methods and (_cli.comm() is None or _cli.comm().rank == 0):
+        print("injection: no FEM baseline yet (the crack-band u-p FEM is to come); running RKPM only", file=sys.stderr)
+    rock = _rock(**material)
+    est = onset_estimates(rock, c, rate)
+    results = Results(NAME, {**material, **setup, "h": list(h), **est})
+    ck = _cli.Checkpoints(checkpoint_every, work_dir, resume)
+    runs = []
+    for hh in sorted(h, reverse=True):
+        label = f"rkpm h={hh:g}"
+        s = solve(hh, **setup, rock=rock, io=ck.for_run(f"rkpm-h{hh:g}"), comm=_cli.comm())
+        rows = {k: np.array(v, float) for k, v in s["rec"].rows.items()}
+        outside = np.flatnonzero(rows["cracked"] > 0)
+        onset = float(rows["t"][outside[0]]) if outside.size else None
+        right, left = rows["right"][-1], -rows["left"][-1]
+        wing = max(right, left) - (c + 0.5 * hh)
+        errors = {"wing_asymmetry": abs(right - left) / max(wing, hh)}
+        info = {"h": hh, "particles": s["nodes"], "onset_t": onset,
+                "onset_p": None if onset is None else float(rows["notch_p"][outside[0]]),
+                "length_end": right + left, "steps": s["steps"], "cuts": s["cuts"], "newton": s["newton"],
+                "max_iterations": int(max(rows["iterations"])), "damaged": s["damaged"],
+                "q_max_cracked": s["q_max_cracked"], "q_max_intact": s["q_max_intact"]}
+        series = {"t": rows["t"], "left": rows["left"], "right": rows["right"], "cracked": rows["cracked"],
+                  "notch_p": rows["notch_p"],
+                  "iterations": rows["iterations"], "map_t": s["rec"].maps["t"], "map_p": s["rec"].maps["p"],
+                  "map_damage": s["rec"].maps["damage"], "map_x": s["x_shown"], "map_shape": list(s["shape"]),
+                  "arrow_x": s["arrow_x"], "arrow_q": s["arrow_q"]}
+        runs.append(Run(label, s["wall"], s["n_dofs"], series=series, errors=errors, info=info))
+    if len(runs) >= 2:
+        fine, coarse = runs[-1], runs[-2]
+        pf, pc = np.asarray(fine.series["map_p"][-1]), np.asarray(coarse.series["map_p"][-1])
+        fine.errors["p_l2_vs_coarser"] = float(np.linalg.norm(pf - pc) / np.linalg.norm(pf))
+        fine.errors["length_vs_coarser"] = fine.info["length_end"] / coarse.info["length_end"] - 1.0
+    results.runs.extend(runs)
+    return results
+
+
+def plot(results: Results, out: Path) -> list[Path]:
+    """Pressure and damage maps (Fig 5.6), pressure with Darcy arrows (Fig 5.7), crack growth."""
+    plt = _cli.pyplot()
+    prm = results.params
+    L = prm["L"]
+    files = []
+    ext = (-L / 2, L / 2, -L / 2, L / 2)
+    for r in results.runs:
+        ts = r.series["map_t"]
+        if not ts:
+            continue
+        fig, axes = plt.subplots(2, len(ts), figsize=(3.6 * len(ts), 7), squeeze=False)
+        shape = r.series["map_shape"]
+        pmax = max(np.max(p) for p in r.series["map_p"])
+        for j, t in enumerate(ts):
+            p = np.asarray(r.series["map_p"][j]).reshape(SAMPLES, SAMPLES).T  # rows y, columns x
+            im = axes[0, j].imshow(p, origin="lower", extent=ext, cmap="viridis", vmin=0, vmax=pmax)
+            axes[0, j].set_title(f"p, t = {t:g} s", fontsize=9)
+            d = np.asarray(r.series["map_damage"][j]).reshape(shape)
+            im2 = axes[1, j].imshow(d, origin="lower", extent=ext, cmap="magma_r", vmin=0, vmax=1)
+            axes[1, j].set_title(f"damage, t = {t:g} s", fontsize=9)
+        fig.colorbar(im, ax=axes[0, :].tolist(), shrink=0.8, label="p [Pa]")
+        fig.colorbar(im2, ax=axes[1, :].tolist(), shrink=0.8, label="D [-]")
+        fig.suptitle(f"Injection at the notch, p_bar = {prm['rate']:g} t Pa, {r.method} ({r.info['particles']:,} particles)")
+        files.append(_cli.save(fig, out / f"maps_h{r.info['h']:g}.png"))
+    fig, axes = plt.subplots(1, len(results.runs), figsize=(5.5 * len(results.runs), 5), squeeze=False)
+    for ax, r in zip(axes[0], results.runs):
+        p = np.asarray(r.series["map_p"][-1]).reshape(SAMPLES, SAMPLES).T
+        im = ax.imshow(p, origin="lower", extent=ext, cmap="viridis")
+        xa, qa = np.asarray(r.series["arrow_x"]), np.asarray(r.series["arrow_q"])
+        ax.quiver(xa[:, 0], xa[:, 1], qa[:, 0], qa[:, 1], color="w", scale=None, width=0.003)
+        ax.set_title(f"p and Darcy velocity at t = {r.series['map_t'][-1]:g} s, {r.method}", fontsize=9)
+        fig.colorbar(im, ax=ax, shrink=0.8, label="p [Pa]")
+    fig.tight_layout()
+    files.append(_cli.save(fig, out / "darcy.png"))
+    fig, axes = plt.subplots(1, 3, figsize=(17, 4.8))
+    for r in results.runs:
+        axes[2].plot(np.asarray(r.series["t"]), np.asarray(r.series["notch_p"]), "-", label=r.method)
+        t = np.asarray(r.series["t"])
+        axes[0].plot(t, np.asarray(r.series["right"]), "-", label=f"{r.method}, right tip")
+        axes[0].plot(t, -np.asarray(r.series["left"]), "--", label=f"{r.method}, left tip (mirrored)")
+        axes[1].plot(t, np.asarray(r.series["iterations"]), ".-", label=r.method)
+    for key, style in (("t_strength", ":"), ("t_lefm", "-.")):
+        axes[0].axvline(prm[key], color="0.4", ls=style, lw=1, label=key.replace("t_", "onset by "))
+    axes[0].set_xlabel("t [s]")
+    axes[0].set_ylabel("tip |x| [m] (outermost cracked cell)")
+    axes[0].legend(fontsize=7)
+    axes[0].grid(alpha=0.3)
+    axes[1].set_xlabel("t [s]")
+    axes[1].set_ylabel(f"Newton iterations per step ({prm['jacobian']} Jacobian)")
+    axes[1].legend(fontsize=7)
+    axes[1].grid(alpha=0.3)
+    for key, style in (("p_strength", ":"), ("p_lefm", "-.")):
+        axes[2].axhline(prm[key], color="0.4", ls=style, lw=1, label=key.replace("p_", "onset by "))
+    axes[2].set_xlabel("t [s]")
+    axes[2].set_ylabel("p at the notch's centre [Pa]")
+    axes[2].legend(fontsize=7)
+    axes[2].grid(alpha=0.3)
+    fig.tight_layout()
+    files.append(_cli.save(fig, out / "growth.png"))
+    return files
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Command-line entry point (see the module docstring)."""
+    return _cli.main(NAME, __doc__, PARAMS, run, plot, argv, QUICK, checkpoints=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,83 @@
+"""Fluid injection into a notched saturated plate (seed 5.3.2) at the quick sizes.
+
+Measured on the quick sizes (h = 0.05 and 0.025 m, steps of 100 s to 2000 s, full Jacobian):
+
+    h       onset (w/w_c >= 0.5 outside the notch)   tips at 2000 s   Newton (20 steps)
+    0.05    none by 2000 s                           +-0.125 m        88
+    0.025   1900 s (p_bar = 1.05e8 Pa)               +-0.1625 m       93
+
+The relative L2 difference of p between the two at 2000 s is 8.5 %. The onset comes after the
+LEFM estimate for an impermeable rock (809 s): the pore pressure reaches the tips within
+seconds (c_v ~ 9e-3 m^2/s), so only its gradient loads the skeleton.
+"""
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from rkfx.cases import injection as case
+
+
+def _params(**over):
+    return {k: v.default for k, v in case.PARAMS.items()} | case.QUICK | over
+
+
+@pytest.fixture(scope="module")
+def quick():
+    return case.run(methods=("rkpm",), **_params())
+
+
+def test_crack_grows_along_the_notch_with_matching_wings(quick):
+    coarse, fine = quick.runs
+    for r in (coarse, fine):
+        right, left = np.asarray(r.series["right"]), -np.asarray(r.series["left"])
+        np.testing.assert_allclose(right, left, atol=1e-12)  # symmetric plate, symmetric crack
+        assert r.errors["wing_asymmetry"] < 0.1
+        assert right[0] >= quick.params["c"] and np.all(np.diff(right) >= -1e-12)  # the notch, never healing
+    assert np.asarray(fine.series["right"])[-1] > quick.params["c"] + fine.info["h"]  # grown out of the notch
+    x, d = np.asarray(fine.series["map_x"]), np.asarray(fine.series["map_damage"][-1])
+    assert np.abs(x[d > 0.5, 1]).max() <= 2 * fine.info["h"] + 1e-12  # tracking keeps it on the notch's line
+
+
+def test_onset_after_the_impermeable_lefm_estimate(quick):
+    prm = quick.params
+    assert prm["t_strength"] < prm["t_lefm"]
+    fine = quick.runs[-1]
+    assert fine.info["onset_t"] is not None and fine.info["onset_t"] > prm["t_lefm"]
+    assert np.isclose(fine.info["onset_p"], prm["rate"] * fine.info["onset_t"])
+
+
+def test_darcy_velocity_largest_along_the_crack(quick):
+    fine = quick.runs[-1]
+    assert fine.info["q_max_cracked"] > fine.info["q_max_intact"]
+
+
+def test_newton_converges_and_refinements_are_compared(quick):
+    for r in quick.runs:
+        assert r.info["cuts"] == 0 and r.info["max_iterations"] <= 10
+        assert len(r.series["iterations"]) == len(r.series["t"])
+    assert 0 < quick.runs[-1].errors["p_l2_vs_coarser"] < 0.2
+
+
+def test_resume_continues_to_the_same_result(tmp_path):
+    p = _params(h=[0.05], t_end=1000.0, t_out=[600.0, 1000.0])
+    whole = case.run(methods=("rkpm",), **p)
+    # Stopped at 600 s (as a killed run would be, at its last checkpoint), then continued.
+    case.run(methods=("rkpm",), **(p | {"t_end": 600.0, "t_out": [600.0]}), checkpoint_every=2,
+             work_dir=tmp_path / "checkpoints")
+    resumed = case.run(methods=("rkpm",), **p, resume=tmp_path / "checkpoints")
+    a, b = whole.runs[0], resumed.runs[0]
+    np.testing.assert_array_equal(a.series["right"], b.series["right"])
+    np.testing.assert_array_equal(a.series["t"], b.series["t"])
+    np.testing.assert_allclose(a.series["map_p"], b.series["map_p"], rtol=1e-10, atol=1e-3)
+
+
+@pytest.mark.parametrize("args, word", [(["--method", "fem"], "no FEM baseline"), (["--set", "h=0.03"], "divide"),
+                                        (["--set", "jacobian=exact"], "jacobian")])
+def test_bad_input_is_refused_in_one_line(args, word, tmp_path):
+    out = subprocess.run([sys.executable, "-m", "rkfx.cases.injection", "--quick", *args, "--out", str(tmp_path)],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 2
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and word in lines[0]
