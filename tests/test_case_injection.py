@@ -81,3 +81,18 @@ def test_bad_input_is_refused_in_one_line(args, word, tmp_path):
     assert out.returncode == 2
     lines = out.stderr.strip().splitlines()
     assert len(lines) == 1 and word in lines[0]
+
+
+def test_a_run_that_stops_keeps_what_it_reached(monkeypatch):
+    from rkfx.errors import SolverError  # noqa: PLC0415
+
+    real = case.integrate
+
+    def stops_at_half(stepper, model, times, **kw):
+        real(stepper, model, times[: len(times) // 2 + 1], **kw)
+        raise SolverError("Newton failed at step 11 (t = 1050 s): for the test")
+
+    monkeypatch.setattr(case, "integrate", stops_at_half)
+    r = case.run(methods=("rkpm",), **_params(h=[0.05])).runs[0]
+    assert "step 11" in r.series["stopped"] and r.info["t_reached"] == 1000.0
+    assert len(r.series["t"]) == 10 and len(r.series["map_t"]) == 1  # the 1000 s map, not the 2000 s one

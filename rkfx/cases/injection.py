@@ -30,9 +30,12 @@ Reported per run: the crack's tips and length against time (the outermost cracke
 w / w_c >= 0.5), the onset of propagation (the first step with a cracked particle outside the
 notch: time and notch pressure) beside a strength estimate (p_bar = f_t) and an LEFM estimate
 (p_bar sqrt(pi c) = sqrt(E G_F / (1 - nu^2))), the wings' asymmetry, Newton iterations per
-step, the pressure and damage maps at ``t_out`` (Fig 5.6) and the Darcy velocity q = -k_f grad p
-at the end (Fig 5.7). Between the two finest runs: the relative L2 difference of p on a common
-sample grid and the crack lengths at t_end.
+step, the maps of pressure and crack opening w / w_c at ``t_out`` (Fig 5.6; D is stored too, but
+once kappa_c >> kappa0 it reaches 0.5 long before a particle has opened, chapter 4) and the
+Darcy velocity q = -k_f grad p at the end (Fig 5.7). Between the two finest runs: the relative
+L2 difference of p on a common sample grid and the crack lengths at t_end. A refinement whose
+Newton fails at the smallest cut keeps what it reached (``t_reached``, the message in its
+``stopped`` series) and the case goes on to the next.
 
 There is no FEM baseline yet (the crack-band u-p FEM is to come): ``--method fem`` is refused,
 ``both`` runs RKPM and says so.
@@ -55,7 +58,7 @@ from rkfx.approximation.shape_functions import evaluate, rk_approximation
 from rkfx.cases import _cli, _preflight
 from rkfx.cases._cli import Param, Results, Run
 from rkfx.conditions import Displacement, Pressure, Region
-from rkfx.errors import InputError
+from rkfx.errors import InputError, SolverError
 from rkfx.fracture import damage as dm
 from rkfx.fracture.tracking import check_tracking, tracking
 from rkfx.geometry.grid_cells import grid_domains
@@ -166,7 +169,7 @@ class _Record:
         self.shown = shown
         self.rows = {k: [] for k in ("t", "left", "right", "cracked", "iterations", "notch_p")}
         self.centre = int(np.argmin(np.hypot(model.p.x[:, 0], model.p.x[:, 1])))
-        self.maps = {"t": [], "p": [], "damage": []}
+        self.maps = {"t": [], "p": [], "damage": [], "opening": []}
         self._seen = 0  # substeps of the model already counted
 
     def opening(self) -> np.ndarray:
@@ -175,6 +178,7 @@ class _Record:
 
     def record(self, s) -> None:
         m = self.model
+        self.last_x = s.x
         x = m.p.x
         cracked = self.opening() >= CRACKED
         left = x[cracked, 0].min() - 0.5 * self.h if cracked.any() else 0.0
@@ -189,6 +193,7 @@ class _Record:
             self.maps["t"].append(s.t)
             self.maps["p"].append(self.sample_rows @ P)
             self.maps["damage"].append(m.committed.damage[self.shown])
+            self.maps["opening"].append(self.opening()[self.shown])
 
     def sample_centre(self, s) -> float:
         """p^h at the notch's centre particle [Pa]."""
@@ -235,10 +240,16 @@ def solve(h: float, *, L, c, rate, t_end, dt, t_out, tol, radius, jacobian, supp
     io = io or {}
     # Backtracking: near the damage threshold the loading set of the tangent can flip between
     # two iterates and plain Newton cycles between them.
-    run = integrate(trapezoidal(newton=NewtonOptions(line_search=True)), model, times, recorder=rec, comm=comm, max_cuts=max_cuts,
-                    progress=lambda it: _cli.progress(it, f"h={h:g}", len(times) - 1), **io)
-    # Darcy velocity at the end: q = -k_f grad p at the particles.
-    P = run.state.x[2 * model.n:]
+    stopped = None
+    try:
+        run = integrate(trapezoidal(newton=NewtonOptions(line_search=True)), model, times, recorder=rec, comm=comm,
+                        max_cuts=max_cuts, progress=lambda it: _cli.progress(it, f"h={h:g}", len(times) - 1), **io)
+    except SolverError as err:  # keep what the run reached; the message says where and why it stopped
+        stopped = str(err)
+        print(f"injection: h = {h:g} stopped: {stopped}", file=sys.stderr)
+        run = None
+    # Darcy velocity at the end (the last step reached): q = -k_f grad p at the particles.
+    P = (run.state.x if run is not None else rec.last_x)[2 * model.n:]
     grad = np.column_stack([model.nodal.gradients.matrix(0) @ P, model.nodal.gradients.matrix(1) @ P])
     k = model.permeability(model.committed, model.strain)
     q = -np.einsum("nij,nj->ni", k, grad)
@@ -248,7 +259,8 @@ def solve(h: float, *, L, c, rate, t_end, dt, t_out, tol, radius, jacobian, supp
     qn = np.hypot(q[:, 0], q[:, 1])
     notch_p = np.asarray(rec.rows["notch_p"])
     return {"rec": rec, "h": h, "notch_p": notch_p, "nodes": p.num_nodes, "n_dofs": 3 * p.num_nodes, "wall": time.perf_counter() - t0,
-            "steps": run.steps, "substeps": run.substeps, "cuts": run.cuts, "newton": run.newton_iterations,
+            "stopped": stopped, "steps": len(rec.rows["t"]),
+            "cuts": None if run is None else run.cuts, "newton": int(sum(model.iterations)),
             "iterations": list(model.iterations), "x_shown": p.x[shown], "shape": (len(keep), len(keep)),
             "arrow_x": p.x[arrow_nodes], "arrow_q": q[arrow_nodes], "q_max_cracked": float(qn[cracked].max()),
             "q_max_intact": float(qn[~cracked].max()), "damaged": int(model.committed.damaged.sum())}
@@ -281,17 +293,18 @@ def run(*, methods: Sequence[str] = ("rkpm",), E=2.1e11, nu=0.3, rho_s=3000.0, r
         wing = max(right, left) - (c + 0.5 * hh)
         errors = {"wing_asymmetry": abs(right - left) / max(wing, hh)}
         info = {"h": hh, "particles": s["nodes"], "onset_t": onset,
+                "t_reached": float(rows["t"][-1]) if len(rows["t"]) else 0.0,
                 "onset_p": None if onset is None else float(rows["notch_p"][outside[0]]),
                 "length_end": right + left, "steps": s["steps"], "cuts": s["cuts"], "newton": s["newton"],
                 "max_iterations": int(max(rows["iterations"])), "damaged": s["damaged"],
                 "q_max_cracked": s["q_max_cracked"], "q_max_intact": s["q_max_intact"]}
         series = {"t": rows["t"], "left": rows["left"], "right": rows["right"], "cracked": rows["cracked"],
-                  "notch_p": rows["notch_p"],
+                  "notch_p": rows["notch_p"], "stopped": s["stopped"],
                   "iterations": rows["iterations"], "map_t": s["rec"].maps["t"], "map_p": s["rec"].maps["p"],
-                  "map_damage": s["rec"].maps["damage"], "map_x": s["x_shown"], "map_shape": list(s["shape"]),
+                  "map_damage": s["rec"].maps["damage"], "map_opening": s["rec"].maps["opening"], "map_x": s["x_shown"], "map_shape": list(s["shape"]),
                   "arrow_x": s["arrow_x"], "arrow_q": s["arrow_q"]}
         runs.append(Run(label, s["wall"], s["n_dofs"], series=series, errors=errors, info=info))
-    if len(runs) >= 2:
+    if len(runs) >= 2 and all(r.series["stopped"] is None for r in runs[-2:]):
         fine, coarse = runs[-1], runs[-2]
         pf, pc = np.asarray(fine.series["map_p"][-1]), np.asarray(coarse.series["map_p"][-1])
         fine.errors["p_l2_vs_coarser"] = float(np.linalg.norm(pf - pc) / np.linalg.norm(pf))
@@ -318,11 +331,11 @@ def plot(results: Results, out: Path) -> list[Path]:
             p = np.asarray(r.series["map_p"][j]).reshape(SAMPLES, SAMPLES).T  # rows y, columns x
             im = axes[0, j].imshow(p, origin="lower", extent=ext, cmap="viridis", vmin=0, vmax=pmax)
             axes[0, j].set_title(f"p, t = {t:g} s", fontsize=9)
-            d = np.asarray(r.series["map_damage"][j]).reshape(shape)
+            d = np.asarray(r.series["map_opening"][j]).reshape(shape)
             im2 = axes[1, j].imshow(d, origin="lower", extent=ext, cmap="magma_r", vmin=0, vmax=1)
-            axes[1, j].set_title(f"damage, t = {t:g} s", fontsize=9)
+            axes[1, j].set_title(f"crack opening w / w_c, t = {t:g} s", fontsize=9)
         fig.colorbar(im, ax=axes[0, :].tolist(), shrink=0.8, label="p [Pa]")
-        fig.colorbar(im2, ax=axes[1, :].tolist(), shrink=0.8, label="D [-]")
+        fig.colorbar(im2, ax=axes[1, :].tolist(), shrink=0.8, label="w / w_c [-] (cracked from 0.5)")
         fig.suptitle(f"Injection at the notch, p_bar = {prm['rate']:g} t Pa, {r.method} ({r.info['particles']:,} particles)")
         files.append(_cli.save(fig, out / f"maps_h{r.info['h']:g}.png"))
     fig, axes = plt.subplots(1, len(results.runs), figsize=(5.5 * len(results.runs), 5), squeeze=False)
