@@ -231,7 +231,6 @@ class HydraulicFractureModel:
             self._admit(np.flatnonzero(self.committed.damaged), self.committed.normal, self.allowed, self.parent)
         self.trial: dm.DamageUpdate | None = None
         self.strain = np.zeros((n, 3))
-        self._bands_width = None
         self._mass = np.r_[lumped_mass(self.volume, rock.density), np.zeros(n)]
         self._col = collocation(p, rk, [(displacements, 0, 2), (pressures, 2 * n, 1)], 3 * n)
         bq = boundary_quadrature(p, domains, rk)
@@ -240,14 +239,14 @@ class HydraulicFractureModel:
         if injection is not None:
             region, rate = injection
             inside = part_nodes(p, region)
-            share = np.zeros(n)
-            share[inside] = self.volume[inside] / self.volume[inside].sum()
-            self._injection = (self._values.T @ share, rate)  # int N_I s dOmega per unit injected volume
+            fraction = np.zeros(n)  # of the injected fluid, per particle of the region (by volume)
+            fraction[inside] = self.volume[inside] / self.volume[inside].sum()
+            self._injection = (self._values.T @ fraction, rate)  # int N_I s dOmega per unit injected volume
         self._h = np.sqrt(domains.area)
         self._intact = rock.intact()
         self.iterations: list[int] = []
         self._count = 0
-        self._capacity: tuple[float, sp.csr_matrix] | None = None
+        self._capacity: tuple[float, dm.DamageState, sp.csr_matrix] | None = None
         self._k_stab: tuple[dm.DamageState, sp.csr_matrix] | None = None
 
     # ------------------------------------------------------------------ fields of a damage state
@@ -381,8 +380,7 @@ class HydraulicFractureModel:
 
     def capacity(self, dt: float) -> sp.csr_matrix:
         """[[0, 0], [K_C^T, S + S_fpp(dt)]] of the committed damage (built once per step)."""
-        key = (dt, id(self.committed))
-        if self._capacity is None or self._capacity[0] != key:
+        if self._capacity is None or self._capacity[0] != dt or self._capacity[1] is not self.committed:
             st = self.committed
             alpha = self.rock.biot(st.damage)
             it = self.integration
@@ -395,8 +393,8 @@ class HydraulicFractureModel:
                        sp.csr_matrix((self.n, self.n)))
             n2 = 2 * self.n
             cap = sp.bmat([[sp.csr_matrix((n2, n2)), None], [kc.T, (ks + stab).tocsr()]], format="csr")
-            self._capacity = (key, cap)
-        return self._capacity[1]
+            self._capacity = (dt, self.committed, cap)
+        return self._capacity[2]
 
     def constraints(self, t: float) -> Constraints:
         return Constraints(self._col.G, self._col.values(self.p.x, t))
