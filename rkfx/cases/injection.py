@@ -355,22 +355,16 @@ def plot(results: Results, out: Path) -> list[Path]:
         axes[0].plot(t, np.asarray(r.series["right"]), "-", label=f"{r.method}, right tip")
         axes[0].plot(t, -np.asarray(r.series["left"]), "--", label=f"{r.method}, left tip (mirrored)")
         axes[1].plot(t, np.asarray(r.series["iterations"]), ".-", label=r.method)
-    for key, style in (("t_strength", ":"), ("t_lefm", "-.")):
-        axes[0].axvline(prm[key], color="0.4", ls=style, lw=1, label=key.replace("t_", "onset by "))
-    axes[0].set_xlabel("t [s]")
-    axes[0].set_ylabel("tip |x| [m] (outermost cracked cell)")
-    axes[0].legend(fontsize=7)
-    axes[0].grid(alpha=0.3)
-    axes[1].set_xlabel("t [s]")
-    axes[1].set_ylabel(f"Newton iterations per step ({prm['jacobian']} Jacobian)")
-    axes[1].legend(fontsize=7)
-    axes[1].grid(alpha=0.3)
-    for key, style in (("p_strength", ":"), ("p_lefm", "-.")):
-        axes[2].axhline(prm[key], color="0.4", ls=style, lw=1, label=key.replace("p_", "onset by "))
-    axes[2].set_xlabel("t [s]")
-    axes[2].set_ylabel("p at the notch's centre [Pa]")
-    axes[2].legend(fontsize=7)
-    axes[2].grid(alpha=0.3)
+    for style, kind in ((":", "strength"), ("-.", "lefm")):
+        axes[0].axvline(prm[f"t_{kind}"], color="0.4", ls=style, lw=1, label=f"onset by {kind}")
+        axes[2].axhline(prm[f"p_{kind}"], color="0.4", ls=style, lw=1, label=f"onset by {kind}")
+    for ax, label in zip(axes, ("tip |x| [m] (outermost cracked cell)",
+                                f"Newton iterations per step ({prm['jacobian']} Jacobian)",
+                                "p at the notch's centre [Pa]")):
+        ax.set_xlabel("t [s]")
+        ax.set_ylabel(label)
+        ax.legend(fontsize=7)
+        ax.grid(alpha=0.3)
     fig.tight_layout()
     files.append(_cli.save(fig, out / "growth.png"))
     return files

@@ -46,7 +46,7 @@ from rkfx.fracture.tracking import Tracking
 from rkfx.geometry.nodal_domains import NodalDomains
 from rkfx.geometry.particles import Particles
 from rkfx.materials import crack_flow
-from rkfx.models.hydro_damage import RESIDUAL_STIFFNESS, CrackBands
+from rkfx.models.hydro_damage import RESIDUAL_STIFFNESS, CrackBands, crack_permeability
 from rkfx.models.poroelasticity import (PoroMaterial, biot_integration, boundary_loads, divergence_matrix,
                                         fpp_parameter, projection_rows)
 from rkfx.solvers.fields import layout
@@ -217,7 +217,7 @@ class HydraulicFractureModel:
         self._grad = it.nodal.gradients
         self._values = it.nodal.values.matrix()
         self._div = divergence_matrix(it.nodal)
-        self._bt = _strain_transpose(self._grad)
+        self._bt = strain_matrix(self._grad).T.tocsr()
         self._fpp = projection_rows(rk, domains, it)
         self._C = rock.damage_material.elasticity()
         self.points = dm.damage_model(rock.damage_material, self.volume, geometry=dm.cell_geometry(domains))
@@ -263,16 +263,10 @@ class HydraulicFractureModel:
             w[on] = np.where(ok, self.volume[on] / np.where(ok, chord, 1.0), np.sqrt(self.volume[on]))
         return w
 
-    def apertures(self, state: dm.DamageState, strain: np.ndarray) -> np.ndarray:
-        """w = D L_s max(n . eps~ . n, 0) (5.13) per particle [m]."""
-        return crack_flow.crack_aperture(state.damage, self.band_widths(state), _unit(state.normal), strain)
-
     def permeability(self, state: dm.DamageState, strain: np.ndarray) -> np.ndarray:
         """k_f (5.8) per particle, shape ``(n, 2, 2)`` [m^2/(Pa s)]."""
-        bands = CrackBands(_unit(state.normal), self.band_widths(state))
-        w = crack_flow.crack_aperture(state.damage, bands.width, bands.normal, strain)
-        kfc = crack_flow.fracture_permeability(w, bands.width, self.rock.viscosity)
-        return crack_flow.permeability_tensor(self.rock.mobility, kfc, bands.normal)
+        return crack_permeability(self.rock.mobility, state.damage, CrackBands(_unit(state.normal),
+                                  self.band_widths(state)), strain, self.rock.viscosity)
 
     def pressures(self, x: np.ndarray) -> np.ndarray:
         """p^h at the particles for the unknowns ``x`` [Pa], shape ``(n,)``."""
@@ -467,6 +461,3 @@ def _unit(normal: np.ndarray) -> np.ndarray:
     n[zero] = (0.0, 1.0)
     return n
 
-
-def _strain_transpose(grad) -> sp.csr_matrix:
-    return strain_matrix(grad).T.tocsr()

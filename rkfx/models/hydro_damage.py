@@ -63,6 +63,15 @@ def crack_apertures(damage: np.ndarray, bands: CrackBands, strain: np.ndarray) -
     return crack_flow.crack_aperture(damage, bands.width, bands.normal, strain)
 
 
+def crack_permeability(mobility: float, damage: np.ndarray, bands: CrackBands, strain: np.ndarray,
+                       viscosity: float) -> np.ndarray:
+    """k_f (5.8) of every particle, shape ``(n, 2, 2)`` [m^2/(Pa s)]: k_fC = w^3 / (12 mu_f L_s)
+    (5.12) along the crack with w (5.13) from the smeared ``strain``, k_f0 = ``mobility`` across."""
+    w = crack_apertures(damage, bands, strain)
+    return crack_flow.permeability_tensor(mobility, crack_flow.fracture_permeability(w, bands.width, viscosity),
+                                          bands.normal)
+
+
 def _damage(damage, n: int | None = None) -> np.ndarray:
     d = np.asarray(damage, float).reshape(-1)
     if n is not None and len(d) != n:
@@ -106,7 +115,5 @@ def damaged_fields(elastic: ElasticMaterial, damage: np.ndarray, *, residual: fl
             raise InputError("the crack permeability (5.8) needs mobility, strain and viscosity with the bands")
         if len(bands.width) != n:
             raise InputError(f"crack bands for {len(bands.width)} particles; give one per particle ({n})")
-        w = crack_apertures(d, bands, strain)
-        k = crack_flow.permeability_tensor(mobility, crack_flow.fracture_permeability(w, bands.width, viscosity),
-                                           bands.normal)
+        k = crack_permeability(mobility, d, bands, strain, viscosity)
     return NodalFields(D=stiffness, k=k, alpha=alpha, S=storage)
