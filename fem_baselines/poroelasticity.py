@@ -511,8 +511,9 @@ class _Samples:
     """Point values of (u, p) at the output steps, for ``rkfx.solvers.integrate``."""
 
     def __init__(self, model: FemBiotModel, sampler: _Sampler, steps: np.ndarray,
-                 uh: dolfinx.fem.Function, ph: dolfinx.fem.Function):
+                 uh: dolfinx.fem.Function, ph: dolfinx.fem.Function, vtk=None):
         self.model, self.sampler, self.steps, self.uh, self.ph = model, sampler, steps, uh, ph
+        self.vtk = vtk
         m = sampler.x3.shape[0]
         self.p = np.full((len(steps), m), np.nan)
         self.u = np.full((len(steps), m, 2), np.nan)
@@ -523,6 +524,8 @@ class _Samples:
         for j in np.flatnonzero(self.steps == s.step):
             self.model.assign(s.x, self.uh, self.ph)
             self.p[j], self.u[j] = self.sampler(self.uh, self.ph)
+            if self.vtk is not None:
+                self.vtk.write(s.t, displacement=self.uh, pressure=self.ph)
         self.seconds += time.perf_counter() - t0
 
     def arrays(self) -> dict[str, np.ndarray]:
@@ -555,6 +558,7 @@ def solve_biot(
     checkpoint_every: int = 0,
     checkpoint_dir: str | Path | None = None,
     resume: str | Path | None = None,
+    vtk=None,
 ) -> BiotResult:
     """Solve plane-strain Biot consolidation with backward Euler and a monolithic u-p solve.
 
@@ -596,6 +600,8 @@ def solve_biot(
             state: under MPI give each rank a folder of its own.
         resume: A checkpoint folder to continue from (same mesh, data and times); the result
             equals that of an uninterrupted run.
+        vtk: A ``fem_baselines.paraview.FemSeries`` on ``mesh`` that receives u and p at the
+            output times (a resumed run writes the times after its checkpoint), or ``None``.
 
     Returns:
         The sampled history and final fields; see :class:`BiotResult`.
@@ -635,7 +641,7 @@ def solve_biot(
     n = model.layout.size
     start = StepState(0, float(times[0]), model.vector(uh, ph), np.zeros(n), np.zeros(n),
                       np.zeros(model.num_constraints))
-    kept = _Samples(model, _Sampler(mesh, sample_points), out_index, uh, ph)
+    kept = _Samples(model, _Sampler(mesh, sample_points), out_index, uh, ph, vtk)
     kept.record(start)
     t_setup, sampled = time.perf_counter() - t_start, kept.seconds
 

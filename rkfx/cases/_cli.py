@@ -16,12 +16,18 @@ Results go to ``DIR/results.json`` (default ``results/<name>/``) with the schema
 
 (numpy arrays become lists; non-finite floats become null).
 
+``--vtk`` also writes each run's fields through time for ParaView into ``DIR/vtk/``: RKPM
+particles and nodal cells as ``<run>_particles.pvd`` / ``<run>_cells.pvd`` (``rkfx.output.paraview``),
+FEM functions as ``<run>.pvd`` (``fem_baselines.paraview``); the case's ``run`` receives the folder
+as ``vtk``.
+
 Cases with checkpoints keep their runs' files in ``DIR/checkpoints/<run>/`` with the
 fingerprint of the invocation (``fingerprint.json``: case, rkfx version, method, parameters).
 ``--resume DIR`` refuses, in one line naming the differing values, to read back runs computed
 with other parameters, unless ``--recompute`` asks to compute them again.
 """
 import argparse
+import inspect
 import json
 import logging
 import math
@@ -42,6 +48,7 @@ from rkfx.parallel.threads import share_cores
 from rkfx.solvers.checkpoint import has_checkpoint, run_folder
 from rkfx.warmup import warm_up
 
+VTK_FOLDER = "vtk"  # OUT/vtk: the ParaView files of --vtk
 METHODS = {"rkpm": ("rkpm",), "fem": ("fem",), "both": ("rkpm", "fem")}
 
 
@@ -193,6 +200,8 @@ def build_parser(name: str, doc: str | None, specs: Mapping[str, Param],
                         help="override parameters (--set a=1 b=2 or --set a=1 --set b=2)")
     parser.add_argument("--out", type=Path, default=None,
                         help=f"output directory (default results/{name}/, or DIR with --resume DIR)")
+    parser.add_argument("--vtk", action="store_true",
+                        help="also write the fields through time for ParaView into OUT/vtk/ (off by default)")
     if checkpoints:
         parser.add_argument("--checkpoint-every", type=int, default=0, metavar="N",
                             help="write a checkpoint every N time steps (into OUT/checkpoints/)")
@@ -263,6 +272,10 @@ def main(name: str, doc: str | None, specs: Mapping[str, Param], run: Callable[.
                 raise ParameterError("--recompute: give --resume DIR, the folder whose runs to compute again")
             extra = {"checkpoint_every": args.checkpoint_every, "work_dir": Path(args.out) / "checkpoints",
                      "resume": None if args.resume is None else args.resume / "checkpoints"}
+        if args.vtk:
+            if "vtk" not in inspect.signature(run).parameters:
+                raise ParameterError(f"--vtk: the {name} case writes no ParaView files yet; drop --vtk")
+            extra["vtk"] = Path(args.out) / VTK_FOLDER
         check_out(args.out, raw=argv if argv is not None else sys.argv[1:])
         _report_resumes(args.resume if checkpoints else None)
         stamp = fingerprint(name, specs, params, args.method) if checkpoints else None
@@ -292,6 +305,9 @@ def main(name: str, doc: str | None, specs: Mapping[str, Param], run: Callable[.
     print(f"\nresults: {path}")
     for f in figures:
         print(f"figure:  {f}")
+    if args.vtk:
+        for f in sorted((Path(args.out) / VTK_FOLDER).glob("*.pvd")):
+            print(f"paraview: {f}")
     return 0
 
 
@@ -440,10 +456,12 @@ def set_aside_checkpoints(out: Path) -> Path | None:
 
 
 def set_aside_previous(out: Path) -> list[Path]:
-    """Move the results.json and figures of an earlier run in ``out`` to ``out/previous/``, so that
-    a run that fails leaves no outputs that could be taken for its own; returns what moved."""
+    """Move the results.json, figures and ParaView folder of an earlier run in ``out`` to
+    ``out/previous/``, so that a run that fails leaves no outputs that could be taken for its
+    own; returns what moved."""
     out = Path(out)
     stale = [f for f in [out / "results.json", *sorted(out.glob("*.png"))] if f.is_file()] if out.is_dir() else []
+    stale += [d for d in [out / VTK_FOLDER] if d.is_dir()]
     if not stale:
         return []
     previous = out / "previous"
@@ -451,6 +469,7 @@ def set_aside_previous(out: Path) -> list[Path]:
         for f in previous.iterdir():
             if f.is_file():
                 f.unlink()
+        shutil.rmtree(previous / VTK_FOLDER, ignore_errors=True)
     previous.mkdir(exist_ok=True)
     for f in stale:
         f.replace(previous / f.name)

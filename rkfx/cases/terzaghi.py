@@ -35,6 +35,9 @@ variants (list), fem (list), refine_ny (list), support_factor [-].
     python -m rkfx.cases.terzaghi [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
         [--checkpoint-every N] [--resume DIR]
 
+With ``--vtk`` the runs of the variants study write displacement, pressure, strain and effective
+stress at the output times to OUT/vtk/ (RKPM: particles and nodal cells; FEM: dolfinx VTK files).
+
 With ``--checkpoint-every N`` every run (RKPM and FEM) writes its state every N steps (and at its end) to
 OUT/checkpoints/; ``--resume DIR`` continues a killed invocation from DIR/checkpoints/, finished
 runs returning their results at once.
@@ -52,7 +55,7 @@ from rkfx.errors import InputError
 from rkfx.geometry.particles import structured
 from rkfx.models.poroelasticity import VARIANTS, PoroMaterial, solve_biot
 from rkfx.solvers.integrate import time_grid
-from rkfx.cases import _cli, _preflight
+from rkfx.cases import _cli, _paraview, _preflight
 from rkfx.cases._cli import Param, Results, Run
 
 NAME = "terzaghi"
@@ -137,8 +140,9 @@ def memory_need(methods, *, nx, ny, refine_ny, **_) -> _preflight.Need:
                                 "lower nx, ny or refine_ny")
 
 
-def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_factor, io):
-    """Pressure at the samples for each output time, wall time and unknowns."""
+def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_factor, io, vtk=None):
+    """Pressure at the samples for each output time, wall time and unknowns; with ``vtk`` a
+    folder, the fields at the output times are also written there for ParaView."""
     # Fixed bottom, rollers on the sides, the load q on the drained top: for RKPM and FEM alike.
     bcs = [Displacement("bottom"), Displacement("left", components=(0,)), Displacement("right", components=(0,)),
            Pressure("top"),
@@ -149,6 +153,8 @@ def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_f
         sol = solve_biot(p, material, times, outputs, displacements=kinds[Displacement], pressures=kinds[Pressure],
                          tractions=kinds[Traction], variant=method[5:], support_factor=support_factor,
                          comm=_cli.comm(), progress=lambda it: _cli.progress(it, method, len(times) - 1), **io)
+        if vtk is not None:
+            _paraview.write_biot(vtk, method, p, sol, material.elastic, _cli.comm())
         return sol.pressure(samples), sol.wall_time_s, sol.n_dofs
     import dolfinx_solver  # noqa: F401, PLC0415
 
@@ -157,15 +163,20 @@ def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_f
     element = method[4:]
     mesh = fb.rectangle_mesh(np.linspace(0, W, nx), np.linspace(0, H, ny),
                              "triangle" if element == "taylor-hood" else "quadrilateral")
+    series = _paraview.fem_series(vtk, method, mesh)
     res = fb.solve_biot(mesh, material.E, material.nu, material.k, material.alpha, material.S, element, bcs,
-                        times, samples, outputs, **io)
+                        times, samples, outputs, vtk=series, **io)
+    if series is not None:
+        series.close()
     return res.p, res.wall_time_s, res.n_dofs
 
 
 def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e3, nu=0.0, k=1.0e-9, alpha=1.0, S=0.0, W=3.0, H=10.0,
         q=1.0e3, nx=7, ny=21, dt=1.0, t_end=1.0, t_out=(), growth=1.5, variants=VARIANTS, fem=FEM_ELEMENTS,
-        refine_ny=(21, 41, 81), support_factor=1.5, checkpoint_every=0, work_dir=None, resume=None) -> Results:
-    """Both studies for every requested method; see the module docstring."""
+        refine_ny=(21, 41, 81), support_factor=1.5, checkpoint_every=0, work_dir=None, resume=None,
+        vtk=None) -> Results:
+    """Both studies for every requested method; see the module docstring. ``vtk``: a folder for
+    the ParaView files of the variants study's runs (``--vtk``)."""
     t_out = _times(t_out)
     _check(W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny, support_factor)
     material = PoroMaterial(E, nu, k, alpha, S)
@@ -189,7 +200,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e3, nu=0.0, k=1.0e-9, 
                                  steps=len(times) - 1))
     for label in labels:
         p_h, wall, dofs = _solve(label, W, H, nx, ny, material, q, times, outputs, samples, support_factor,
-                                 ck.for_run(label))
+                                 ck.for_run(label), vtk)
         first = p_h[0] / p0
         errors = {"first_step_max_dev_away": float(np.abs(first - p_exact[0] / p0)[away].max()),
                   "first_step_overshoot": float(first.max() - 1.0),

@@ -325,6 +325,14 @@ class BiotSolution:
         n = evaluate(self.rk, points).matrix()
         return np.stack([(n @ self.U[:, :, c].T).T for c in range(2)], axis=-1)
 
+    def strain(self, points: np.ndarray) -> np.ndarray:
+        """Strain of u^h (direct gradients) at points for every output time, Voigt (xx, yy, 2 xy),
+        shape ``(k, m, 3)`` [-]."""
+        rows = evaluate(self.rk, points, gradients=True)
+        dx, dy = rows.matrix(1), rows.matrix(2)
+        ux, uy = self.U[:, :, 0].T, self.U[:, :, 1].T
+        return np.stack([(dx @ ux).T, (dy @ uy).T, (dy @ ux + dx @ uy).T], axis=-1)
+
 
 class BiotModel(Stateless):
     """The u-p equations (3.32)-(3.37) as a model for the steppers (``rkfx.solvers``).

@@ -1,0 +1,127 @@
+"""Particle fields through time as ParaView files: a ``.vtu`` per output time and a ``.pvd`` index.
+
+A ``FieldSeries`` writes, for each ``write(t, **fields)``,
+
+    FOLDER/NAME_particles_K.vtu   the particles as vertices, the fields as point data
+    FOLDER/NAME_cells_K.vtu       the nodal cells as quadrilateral subcells (optional), the
+                                  fields of each cell's particle as cell data
+
+and rewrites ``NAME_particles.pvd`` / ``NAME_cells.pvd`` (the time index ParaView opens) after
+every step, so a run that stops keeps every step it wrote. Fields are per particle: shape
+``(n,)`` scalars, ``(n, 2)`` vectors (written with a zero z component) and ``(n, 3)`` plane
+tensors in Voigt order (xx, yy, xy), written as ParaView's symmetric tensors (xx, yy, zz, xy,
+yz, xz) with zero out-of-plane components. Under MPI only rank 0 writes (the fields are whole
+there).
+
+    series = FieldSeries("out/vtk", "rkpm", particles.x, cells=nodal_cells(particles))
+    series.write(0.5, displacement=u, pressure=p)
+    # paraview out/vtk/rkpm_particles.pvd
+"""
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from rkfx.errors import InputError
+from rkfx.fracture.damage import cell_geometry
+from rkfx.geometry.nodal_domains import NodalDomains
+from rkfx.geometry.particles import Particles
+
+
+@dataclass(frozen=True)
+class NodalCells:
+    """The nodal cells as quadrilateral subcells.
+
+    Attributes:
+        node: Particle of each subcell, shape ``(m,)``.
+        vertices: Counter-clockwise vertices of each subcell, shape ``(m, 4, 2)`` [m].
+    """
+
+    node: np.ndarray
+    vertices: np.ndarray
+
+
+def nodal_cells(p: Particles | NodalDomains) -> NodalCells:
+    """The nodal cells of ``p`` (median-dual cells of particles, or grid cells of domains that
+    carry their subcell vertices) for ``FieldSeries(cells=...)``."""
+    g = cell_geometry(p)
+    return NodalCells(np.asarray(g.node), np.asarray(g.vertices))
+
+
+def _vtk_values(name: str, a: np.ndarray, n: int) -> np.ndarray:
+    a = np.asarray(a, float)
+    if a.shape[0] != n or a.ndim > 2:
+        raise InputError(f"field {name!r} has shape {a.shape}; give one value, vector (2) or Voigt tensor (3) "
+                         f"per particle ({n})")
+    if a.ndim == 1 or a.shape[1] == 1:
+        return a.reshape(n)
+    if a.shape[1] == 2:
+        return np.column_stack([a, np.zeros(n)])
+    if a.shape[1] == 3:
+        z = np.zeros(n)
+        return np.column_stack([a[:, 0], a[:, 1], z, a[:, 2], z, z])
+    raise InputError(f"field {name!r} has {a.shape[1]} components; give 1, 2 (vector) or 3 (xx, yy, xy)")
+
+
+def write_pvd(path: Path, entries: list[tuple[float, str]]) -> None:
+    """The ParaView collection ``path`` listing ``(time, file)`` entries, replaced atomically."""
+    rows = "\n".join(f'    <DataSet timestep="{t:.17g}" group="" part="0" file="{f}"/>' for t, f in entries)
+    text = ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
+            f"{rows}\n  </Collection>\n</VTKFile>\n")
+    tmp = path.with_suffix(".pvd.tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+class FieldSeries:
+    """Particle fields through time for ParaView (see the module docstring).
+
+    Args:
+        folder: Output folder (created).
+        name: Prefix of the files, e.g. the run's method label.
+        points: Particle coordinates, shape ``(n, 2)`` [m].
+        cells: The nodal cells (``nodal_cells``), or ``None`` to write the particles only.
+        comm: MPI communicator; only its rank 0 writes. ``None``: this process writes.
+    """
+
+    def __init__(self, folder, name: str, points: np.ndarray, cells: NodalCells | None = None, comm=None):
+        self.folder, self.name = Path(folder), str(name).replace("/", "-")
+        self.points = np.asarray(points, float)
+        self.cells = cells
+        self.writes = comm is None or comm.rank == 0
+        self.entries: dict[str, list[tuple[float, str]]] = {"particles": [], "cells": []}
+        if self.writes:
+            self.folder.mkdir(parents=True, exist_ok=True)
+
+    @property
+    def pvd(self) -> Path:
+        """The particles' time index, the file to open in ParaView."""
+        return self.folder / f"{self.name}_particles.pvd"
+
+    def write(self, time: float, **fields: np.ndarray) -> None:
+        """Write the fields at ``time`` [s] and update the time indices."""
+        if not self.writes:
+            return
+        import meshio  # noqa: PLC0415  (an output dependency, loaded when output is asked for)
+
+        n = len(self.points)
+        values = {k: _vtk_values(k, v, n) for k, v in fields.items()}
+        k = len(self.entries["particles"])
+        xyz = np.column_stack([self.points, np.zeros(n)])
+        self._write(meshio.Mesh(xyz, [("vertex", np.arange(n).reshape(-1, 1))], point_data=values),
+                    "particles", k, time)
+        if self.cells is not None:
+            m = len(self.cells.node)
+            corners = np.column_stack([self.cells.vertices.reshape(-1, 2), np.zeros(4 * m)])
+            data = {key: [v[self.cells.node]] for key, v in values.items()}
+            self._write(meshio.Mesh(corners, [("quad", np.arange(4 * m).reshape(m, 4))], cell_data=data),
+                        "cells", k, time)
+
+    def _write(self, mesh, kind: str, k: int, time: float) -> None:
+        import meshio  # noqa: PLC0415
+
+        file = f"{self.name}_{kind}_{k:05d}.vtu"
+        meshio.write(self.folder / file, mesh, binary=True)
+        self.entries[kind].append((float(time), file))
+        write_pvd(self.folder / f"{self.name}_{kind}.pvd", self.entries[kind])

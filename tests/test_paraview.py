@@ -1,0 +1,115 @@
+"""ParaView output: particle and nodal-cell series, the FEM writer, and a case's --vtk files read back."""
+import json
+
+import numpy as np
+import pytest
+
+from rkfx.errors import InputError
+from rkfx.geometry.particles import structured
+from rkfx.output.paraview import FieldSeries, nodal_cells
+from rkfx.cases._paraview import times_of
+
+pv = pytest.importorskip("pyvista")
+
+
+def _read(pvd, t):
+    reader = pv.get_reader(str(pvd))
+    reader.set_active_time_value(t)
+    return reader, reader.read()[0]
+
+
+def test_particle_and_cell_series_read_back(tmp_path):
+    p = structured(2.0, 1.0, 5, 4)
+    series = FieldSeries(tmp_path, "run", p.x, cells=nodal_cells(p))
+    stress = np.column_stack([p.x[:, 0], p.x[:, 1], -p.x[:, 0]])
+    for t in (0.25, 1.0):
+        series.write(t, displacement=t * p.x, pressure=t * p.x[:, 0], stress=stress)
+    reader, mesh = _read(series.pvd, 1.0)
+    assert reader.time_values == [0.25, 1.0]
+    assert mesh.n_points == p.num_nodes
+    np.testing.assert_allclose(mesh.points[:, :2], p.x)
+    np.testing.assert_allclose(mesh.point_data["pressure"], p.x[:, 0])
+    np.testing.assert_allclose(mesh.point_data["displacement"][:, :2], p.x)
+    s = mesh.point_data["stress"]  # symmetric tensor xx, yy, zz, xy, yz, xz
+    np.testing.assert_allclose(s[:, [0, 1, 3]], stress)
+    assert not s[:, [2, 4, 5]].any()
+    _, cells = _read(tmp_path / "run_cells.pvd", 0.25)
+    assert cells.area == pytest.approx(2.0)  # the nodal cells tile the domain
+    np.testing.assert_allclose(np.sort(np.unique(cells.cell_data["pressure"])), np.unique(0.25 * p.x[:, 0]))
+
+
+def test_series_refuses_a_field_of_the_wrong_size(tmp_path):
+    p = structured(1.0, 1.0, 3, 3)
+    series = FieldSeries(tmp_path, "run", p.x)
+    with pytest.raises(InputError, match="'pressure'.*per particle"):
+        series.write(0.0, pressure=np.zeros(4))
+    with pytest.raises(InputError, match="4 components"):
+        series.write(0.0, pressure=np.zeros((9, 4)))
+
+
+def test_index_lists_every_written_step_as_it_goes(tmp_path):
+    p = structured(1.0, 1.0, 3, 3)
+    series = FieldSeries(tmp_path, "run", p.x)
+    series.write(0.5, pressure=np.zeros(9))
+    np.testing.assert_allclose(times_of(series.pvd), [0.5])  # complete after one step
+    series.write(2.0, pressure=np.ones(9))
+    np.testing.assert_allclose(times_of(series.pvd), [0.5, 2.0])
+
+
+def test_fem_series_writes_vertex_and_cell_fields(tmp_path):
+    import dolfinx_solver  # noqa: F401
+    from dolfinx import fem, mesh as dmesh
+    from mpi4py import MPI
+
+    from fem_baselines.paraview import FemSeries
+
+    m = dmesh.create_unit_square(MPI.COMM_SELF, 3, 3)
+    u = fem.Function(fem.functionspace(m, ("Lagrange", 2, (2,))))
+    d = fem.Function(fem.functionspace(m, ("DG", 0)))
+    with FemSeries(tmp_path, "fem-p2", m) as series:
+        for t in (1.0, 3.0):
+            u.interpolate(lambda x: np.vstack([t * x[0], x[1] ** 2]))
+            d.x.array[:] = t
+            series.write(t, displacement=u, damage=d)
+    reader, mesh = _read(tmp_path / "fem-p2.pvd", 3.0)
+    assert reader.time_values == [1.0, 3.0]
+    np.testing.assert_allclose(mesh.point_data["displacement"][:, 0], 3.0 * mesh.points[:, 0], atol=1e-12)
+    np.testing.assert_allclose(mesh.point_data["displacement"][:, 1], mesh.points[:, 1] ** 2, atol=1e-12)
+    np.testing.assert_allclose(mesh.cell_data["damage"], 3.0)
+
+
+def test_terzaghi_vtk_files_hold_the_documented_fields_at_the_output_times(tmp_path):
+    from rkfx.cases import terzaghi
+
+    out = tmp_path / "terzaghi"
+    terzaghi.main(["--quick", "--vtk", "--out", str(out), "--set", "variants=scni+fpp", "fem=taylor-hood",
+                   "refine_ny=21", "t_end=5", "t_out=2"])
+    times = json.loads((out / "results.json").read_text())["runs"][0]["series"]["t"]
+    vtk = out / "vtk"
+    np.testing.assert_allclose(times_of(vtk / "rkpm-scni+fpp_particles.pvd"), times)
+    np.testing.assert_allclose(times_of(vtk / "fem-taylor-hood.pvd"), times)
+    _, rk = _read(vtk / "rkpm-scni+fpp_particles.pvd", times[-1])
+    assert {"displacement", "pressure", "strain", "effective_stress"} <= set(rk.point_data.keys())
+    assert rk.n_points == 7 * 21
+    p0 = json.loads((out / "results.json").read_text())["params"]["p0"]
+    assert np.median(rk.point_data["pressure"]) == pytest.approx(p0, rel=0.02)  # undrained below the top
+    _, fe = _read(vtk / "fem-taylor-hood.pvd", times[-1])
+    assert {"displacement", "pressure"} <= set(fe.point_data.keys())
+    assert np.median(fe.point_data["pressure"]) == pytest.approx(p0, rel=0.02)
+    # A second run in the same folder moves the earlier ParaView files aside with the results.
+    terzaghi.main(["--quick", "--out", str(out), "--set", "variants=scni", "fem=taylor-hood", "refine_ny=21"])
+    assert (out / "previous" / "vtk" / "rkpm-scni+fpp_particles.pvd").is_file() and not (out / "vtk").exists()
+
+
+def test_vtk_is_refused_in_one_line_by_a_case_without_paraview_output(tmp_path, capsys):
+    from rkfx.cases import _cli
+
+    def run(methods, a=1.0):
+        return _cli.Results("demo", {"a": a})
+
+    with pytest.raises(SystemExit) as stop:
+        _cli.main("demo", "demo case", {"a": _cli.Param(1.0, "a value [-]")}, run,
+                  argv=["--vtk", "--out", str(tmp_path)])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert "--vtk" in err and "demo" in err and len(err.splitlines()) == 1
