@@ -12,14 +12,12 @@ complete after every step, so a run that stops keeps every step it wrote.
 """
 from pathlib import Path
 
-import numpy as np
-
 import dolfinx_solver  # noqa: F401  (MPI first)
 from dolfinx import fem, io
 
 
 class FemSeries:
-    """One XDMF time series of a dolfinx mesh (see the module docstring).
+    """One VTK time series of a dolfinx mesh (see the module docstring).
 
     Args:
         folder: Output folder (created on rank 0).
@@ -42,8 +40,7 @@ class FemSeries:
         """The vertex (P1) or cell (DG0) function ``f`` is written through."""
         if key not in self._out:
             element = f.function_space.ufl_element()
-            shape = f.function_space.value_shape if hasattr(f.function_space, "value_shape") \
-                else element.reference_value_shape
+            shape = f.function_space.value_shape
             cellwise = element.embedded_superdegree == 0
             spec = ("DG", 0, tuple(shape)) if cellwise else ("Lagrange", 1, tuple(shape))
             if spec not in self._spaces:

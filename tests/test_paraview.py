@@ -6,8 +6,7 @@ import pytest
 
 from rkfx.errors import InputError
 from rkfx.geometry.particles import structured
-from rkfx.output.paraview import FieldSeries, nodal_cells
-from rkfx.cases._paraview import times_of
+from rkfx.output.paraview import FieldSeries, nodal_cells, pvd_times as times_of
 
 pv = pytest.importorskip("pyvista")
 
@@ -91,6 +90,9 @@ def test_terzaghi_vtk_files_hold_the_documented_fields_at_the_output_times(tmp_p
     _, rk = _read(vtk / "rkpm-scni+fpp_particles.pvd", times[-1])
     assert {"displacement", "pressure", "strain", "effective_stress"} <= set(rk.point_data.keys())
     assert rk.n_points == 7 * 21
+    eps, sig = rk.point_data["strain"], rk.point_data["effective_stress"]  # tensors: xx, yy, zz, xy, yz, xz
+    np.testing.assert_allclose(sig[:, 3], 2 * 500.0 * eps[:, 3], atol=1e-9 * np.abs(sig).max())  # G = E/2 at nu = 0
+    np.testing.assert_allclose(sig[:, 1], 1.0e3 * eps[:, 1], atol=1e-9 * np.abs(sig).max())
     p0 = json.loads((out / "results.json").read_text())["params"]["p0"]
     assert np.median(rk.point_data["pressure"]) == pytest.approx(p0, rel=0.02)  # undrained below the top
     _, fe = _read(vtk / "fem-taylor-hood.pvd", times[-1])

@@ -5,21 +5,20 @@ RKPM runs write their particles and nodal cells through ``rkfx.output.paraview``
 """
 from pathlib import Path
 
-import numpy as np
-
 from rkfx.output.paraview import FieldSeries, nodal_cells
 
 
 def write_biot(folder: Path, label: str, particles, sol, elastic, comm=None) -> FieldSeries:
     """A u-p solution (``rkfx.models.poroelasticity.BiotSolution``) at its output times:
-    displacement [m], pressure [Pa], strain [-] and effective stress D eps(u^h) [Pa] at the
+    displacement [m], pressure [Pa], strain tensor [-] and effective stress D eps(u^h) [Pa] at the
     particles, with the particles' median-dual cells."""
     series = FieldSeries(folder, label, particles.x, cells=nodal_cells(particles), comm=comm)
     if series.writes:
         u, p, eps = sol.displacement(particles.x), sol.pressure(particles.x), sol.strain(particles.x)
         D = elastic.D()
         for k, t in enumerate(sol.times):
-            series.write(t, displacement=u[k], pressure=p[k], strain=eps[k], effective_stress=eps[k] @ D.T)
+            tensor = eps[k] * [1.0, 1.0, 0.5]  # engineering gamma_xy to the tensor's eps_xy
+            series.write(t, displacement=u[k], pressure=p[k], strain=tensor, effective_stress=eps[k] @ D.T)
     return series
 
 
@@ -30,10 +29,3 @@ def fem_series(folder: Path | None, label: str, mesh):
     from fem_baselines.paraview import FemSeries  # noqa: PLC0415  (dolfinx only for FEM runs)
 
     return FemSeries(folder, label, mesh)
-
-
-def times_of(pvd: Path) -> np.ndarray:
-    """The times listed in a ``.pvd`` index."""
-    import re  # noqa: PLC0415
-
-    return np.array([float(t) for t in re.findall(r'timestep="([^"]+)"', Path(pvd).read_text())])

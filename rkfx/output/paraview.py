@@ -18,35 +18,21 @@ there).
     # paraview out/vtk/rkpm_particles.pvd
 """
 import os
-from dataclasses import dataclass
+import re
 from pathlib import Path
 
 import numpy as np
 
 from rkfx.errors import InputError
-from rkfx.fracture.damage import cell_geometry
+from rkfx.fracture.damage import CellGeometry, cell_geometry
 from rkfx.geometry.nodal_domains import NodalDomains
 from rkfx.geometry.particles import Particles
 
 
-@dataclass(frozen=True)
-class NodalCells:
-    """The nodal cells as quadrilateral subcells.
-
-    Attributes:
-        node: Particle of each subcell, shape ``(m,)``.
-        vertices: Counter-clockwise vertices of each subcell, shape ``(m, 4, 2)`` [m].
-    """
-
-    node: np.ndarray
-    vertices: np.ndarray
-
-
-def nodal_cells(p: Particles | NodalDomains) -> NodalCells:
-    """The nodal cells of ``p`` (median-dual cells of particles, or grid cells of domains that
-    carry their subcell vertices) for ``FieldSeries(cells=...)``."""
-    g = cell_geometry(p)
-    return NodalCells(np.asarray(g.node), np.asarray(g.vertices))
+def nodal_cells(p: Particles | NodalDomains) -> CellGeometry:
+    """The nodal cells of ``p`` as quadrilateral subcells (median-dual cells of particles, or grid
+    cells of domains that carry their subcell vertices) for ``FieldSeries(cells=...)``."""
+    return cell_geometry(p)
 
 
 def _vtk_values(name: str, a: np.ndarray, n: int) -> np.ndarray:
@@ -62,6 +48,11 @@ def _vtk_values(name: str, a: np.ndarray, n: int) -> np.ndarray:
         z = np.zeros(n)
         return np.column_stack([a[:, 0], a[:, 1], z, a[:, 2], z, z])
     raise InputError(f"field {name!r} has {a.shape[1]} components; give 1, 2 (vector) or 3 (xx, yy, xy)")
+
+
+def pvd_times(path) -> np.ndarray:
+    """The times listed in a ``.pvd`` time index, shape ``(k,)`` [s]."""
+    return np.array([float(t) for t in re.findall(r'timestep="([^"]+)"', Path(path).read_text())])
 
 
 def write_pvd(path: Path, entries: list[tuple[float, str]]) -> None:
@@ -85,7 +76,7 @@ class FieldSeries:
         comm: MPI communicator; only its rank 0 writes. ``None``: this process writes.
     """
 
-    def __init__(self, folder, name: str, points: np.ndarray, cells: NodalCells | None = None, comm=None):
+    def __init__(self, folder, name: str, points: np.ndarray, cells: CellGeometry | None = None, comm=None):
         self.folder, self.name = Path(folder), str(name).replace("/", "-")
         self.points = np.asarray(points, float)
         self.cells = cells
