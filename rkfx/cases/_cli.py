@@ -59,11 +59,14 @@ class Param:
     ``fingerprint=False`` marks a value that only chooses which runs exist (a list of levels or
     variants, each run stored under its own label): a resume may change it and keeps the
     stored runs. Every other value is part of the fingerprint of the stored runs.
+    ``aliases``: older names that ``--set`` still takes for this parameter (same value and
+    unit); results and fingerprints use the parameter's own name.
     """
 
     default: Any
     doc: str
     fingerprint: bool = True
+    aliases: tuple[str, ...] = ()
 
 
 @dataclass
@@ -137,15 +140,25 @@ def parse_params(specs: Mapping[str, Param], overrides: Sequence[str] = (),
     params = {k: v.default for k, v in specs.items()}
     params.update(base or {})
     valid = ", ".join(specs)
+    names = alias_names(specs)
     for item in overrides:
         name, sep, text = item.partition("=")
         name = name.strip()
         if not sep:
             raise ParameterError(f"--set {item!r}: expected NAME=VALUE; valid names: {valid}")
-        if name not in specs:
+        if name not in specs and name not in names:
             raise ParameterError(f"unknown parameter {name!r}; valid names: {valid}")
+        if name in names:
+            if _rank() == 0:
+                print(f"note: --set {name} is an alias of {names[name]}", file=sys.stderr)
+            name = names[name]
         params[name] = coerce(name, text, specs[name].default)
     return params
+
+
+def alias_names(specs: Mapping[str, Param]) -> dict[str, str]:
+    """``{alias: parameter name}`` of the parameters' ``aliases``."""
+    return {a: k for k, v in specs.items() for a in v.aliases}
 
 
 class _Parser(argparse.ArgumentParser):
@@ -188,7 +201,8 @@ def build_parser(name: str, doc: str | None, specs: Mapping[str, Param],
     width = max(len(k) for k in specs) if specs else 0
     for k, v in specs.items():
         default = ",".join(map(str, v.default)) if isinstance(v.default, (list, tuple)) else v.default
-        lines.append(f"  {k:<{width}}  {v.doc} (default {default})")
+        also = f"; alias {', '.join(v.aliases)}" if v.aliases else ""
+        lines.append(f"  {k:<{width}}  {v.doc} (default {default}{also})")
     if quick:
         lines.append("--quick sets " + ", ".join(f"{k}={_fmt_value(v)}" for k, v in quick.items()))
     summary = (doc or "").strip().split("\n\n")[0]

@@ -178,6 +178,21 @@ def count_branches(points: np.ndarray, opening: np.ndarray, columns: np.ndarray,
     return out
 
 
+def most_cracks(column_x: np.ndarray, counts: np.ndarray, length: float) -> int:
+    """The most separate cracks side by side over ``length`` of x: the largest k such that
+    consecutive columns spanning at least ``length`` [m] are each crossed by k or more cracks
+    (``counts`` of ``count_branches`` at the sorted ``column_x``); 0 if no column is crossed.
+    Short spurs and side cracks, crossed by a column or two, do not count."""
+    x, c = np.asarray(column_x, float), np.asarray(counts, int)
+    best = 0
+    for k in range(1, int(c.max(initial=0)) + 1):
+        edges = np.diff(np.r_[0, (c >= k).astype(int), 0])
+        starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
+        if np.any(x[ends] - x[starts] >= length - 1e-12):
+            best = k
+    return best
+
+
 def run_series(r: DamageRun) -> dict:
     """The series every dynamic fracture run reports: the sampled history (time in µs) and the
     damaged particles (D > 0.01) as indices with their D and w / w_c, which ``damage_map`` draws."""
@@ -202,6 +217,12 @@ def damage_map(ax, series: dict, nx: int, ny: int, lx: float, ly: float, key: st
     return ax.pcolormesh(xe, ye, d.reshape(ny, nx), cmap="inferno_r", vmin=0, vmax=1, rasterized=True)
 
 
+def label_map_axes(ax) -> None:
+    """Axis labels of a map of the plate (coordinates in metres)."""
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+
+
 def plot_dissipation(results, panels: Sequence[tuple[str, str]], path: Path, title: str,
                      label: Callable, order: Callable, scale: float = 1.0, unit: str = "J/m") -> Path | None:
     """Dissipation histories side by side, one panel per study present in ``results``.
@@ -217,7 +238,8 @@ def plot_dissipation(results, panels: Sequence[tuple[str, str]], path: Path, tit
     if not panels:
         return None
     plt = pyplot()
-    fig, axes = plt.subplots(1, len(panels), figsize=(4.7 * len(panels), 3.9), squeeze=False, sharey=True)
+    fig, axes = plt.subplots(1, len(panels), figsize=(4.7 * len(panels), 3.9), squeeze=False, sharey=True,
+                             layout="constrained")
     for ax, (study, head) in zip(axes[0], panels):
         runs = sorted((r for r in results.runs if r.info.get("study") == study), key=order)
         for k, r in enumerate(runs):
@@ -229,5 +251,4 @@ def plot_dissipation(results, panels: Sequence[tuple[str, str]], path: Path, tit
         ax.legend(fontsize=7, loc="upper left")
     axes[0][0].set_ylabel(f"dissipated energy [{unit}]")
     fig.suptitle(title, fontsize=11)
-    fig.tight_layout()
     return save(fig, path)

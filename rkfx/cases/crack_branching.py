@@ -38,7 +38,9 @@ Studies (``h`` lists nominal spacings [m]):
 Metrics per run: ``branches``, the number of major branches (``count_branches`` across every
 grid column in x = 0.08-0.095 m; the most frequent nonzero count, ties to the larger),
 ``branch_x`` [m], the smallest x > a1 where a column is crossed by two or more separate
-cracks (where the crack first splits; NaN if it never does), ``tip_x`` [m], the largest x
+cracks (where the crack first splits; NaN if it never does), ``most_cracks``, the most separate
+cracks that run side by side over at least 5 mm of x anywhere beyond a1 (``_dynamic_fracture.most_cracks``:
+arrested branches and a central crack count, short spurs do not), ``tip_x`` [m], the largest x
 of the cracked particles (crack opening w / w_c >= 0.5, ``_dynamic_fracture``),
 ``dissipated_end`` [J/m] with its history and the share spent in the cracked particles
 (``dissipated_in_cracks``), and ``energy_error`` (max |energy balance| / max
@@ -76,26 +78,27 @@ from rkfx.cases._cli import Param, Results, Run
 NAME = "crack_branching"
 LX, LY, A1, A2 = 0.1, 0.04, 0.05, 0.02
 BRANCH_WINDOW = (0.08, 0.095)  # columns where the branches are counted [m]
+SIDE_BY_SIDE = 5e-3  # x extent over which cracks must run side by side to count in most_cracks [m]
 
 PARAMS = {
     "E": Param(3.2e10, "Young's modulus [Pa]"),
-    "nu": Param(0.2, "Poisson's ratio"),
+    "nu": Param(0.2, "Poisson's ratio [-]"),
     "rho": Param(2450.0, "density [kg/m^3]"),
     "ft": Param(2.72e6, "tensile strength f_t [Pa]"),
     "GF": Param(3.0, "fracture energy G_F [N/m]"),
     "sigma": Param(1.0e6, "traction on the top and bottom edges, a step at t = 0 [Pa]"),
     "plane": Param("strain", "2-D idealization: strain or stress"),
     "t_end": Param(80e-6, "end time [s]"),
-    "tol": Param(0.5, "particle tracking tolerance of (4.22), in (0, 1]"),
+    "tol": Param(0.5, "particle tracking tolerance of (4.22) [-], in (0, 1]"),
     "h": Param([8e-4, 4e-4, 2e-4], "nominal nodal spacings of the regularized models [m]"),
     "unregularized_h": Param([8e-4, 4e-4, 2e-4], "nominal nodal spacings of the constant-kappa_c models [m]"),
     "fem_h": Param([8e-4, 4e-4, 2e-4], "element sizes of the crack-band finite element baseline [m]",
                    fingerprint=False),
-    "support_factor": Param(1.75, "RK support radius / nodal spacing (>= 1.6: see rkfx.cases.kalthoff)"),
-    "courant": Param(0.5, "dt = courant * h / c_d, in (0, 1]"),
-    "radius": Param(3.5, "tracking neighbourhood radius / nodal spacing, >= 1"),
+    "support_factor": Param(1.75, "RK support radius / nodal spacing [-] (>= 1.6: see rkfx.cases.kalthoff)"),
+    "courant": Param(0.5, "dt = courant * h / c_d [-], in (0, 1]"),
+    "radius": Param(3.5, "tracking neighbourhood radius / nodal spacing [-], >= 1"),
     "forward": Param(True, "tracking: candidates only ahead of their particle (false: (4.22) both ways)"),
-    "eps_p": Param(1.0, "weight of the MSCNI stabilization, >= 0 (0: plain SCNI)"),
+    "eps_p": Param(1.0, "weight of the MSCNI stabilization [-], >= 0 (0: plain SCNI)"),
 }
 QUICK = {"h": [1.6e-3, 8e-4], "unregularized_h": [1.6e-3, 8e-4], "fem_h": [1.6e-3, 8e-4]}
 
@@ -180,6 +183,10 @@ def branch_metrics(opening: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> tuple
     return (*_branches(counts, columns), counts)
 
 
+def _most_cracks(counts: np.ndarray, column_x: np.ndarray) -> int:
+    return dyn.most_cracks(column_x, counts, SIDE_BY_SIDE)
+
+
 def _branches(counts: np.ndarray, column_x: np.ndarray) -> tuple[int, float]:
     """(branches, branch_x): the most frequent nonzero number of cracks across the columns in
     ``BRANCH_WINDOW`` (0 if none) and the smallest column x crossed by two or more (NaN if none)."""
@@ -203,12 +210,14 @@ def _run_record(r: DamageRun, study, h, pl: dyn.Plate, dofs) -> Run:
     series = {**dyn.run_series(r), "tip_x": tip_hist, "column_x": pl.xs[pl.xs > A1], "column_bands": counts}
     info = {"study": study, "h_nominal": h, "nx": len(pl.xs), "ny": len(pl.ys), "h": pl.h, "steps": r.steps,
             "dt": r.dt}
-    return Run(r.label, r.wall_time_s, dofs, series, _errors(r, branches, branch_x, tip_x), info)
+    most = _most_cracks(counts, pl.xs[pl.xs > A1])
+    return Run(r.label, r.wall_time_s, dofs, series, _errors(r, branches, branch_x, most, tip_x), info)
 
 
-def _errors(r: DamageRun, branches: int, branch_x: float, tip_x: float) -> dict:
-    return {"branches": branches, "branch_x": branch_x, "tip_x": tip_x, "dissipated_end": float(r.history[-1, 1]),
-            "dissipated_in_cracks": dyn.crack_share(r), "energy_error": r.energy_error}
+def _errors(r: DamageRun, branches: int, branch_x: float, most: int, tip_x: float) -> dict:
+    return {"branches": branches, "branch_x": branch_x, "most_cracks": most, "tip_x": tip_x,
+            "dissipated_end": float(r.history[-1, 1]), "dissipated_in_cracks": dyn.crack_share(r),
+            "energy_error": r.energy_error}
 
 
 def _fem(h: float, prm: dict, io: dict) -> Run:
@@ -229,8 +238,8 @@ def _fem(h: float, prm: dict, io: dict) -> Run:
     series["damaged_cells"] = np.round(res.x[res.triangles[np.asarray(series["damaged_index"], int)]], 7)
     series.update(column_x=columns, column_bands=counts)
     info = {"study": "fem", "h_nominal": h, "h": h, "cells": res.num_cells, "steps": r.steps, "dt": r.dt}
-    return Run(r.label, r.wall_time_s, 2 * res.num_nodes, series, _errors(r, *_branches(counts, columns), tip_x),
-               info)
+    return Run(r.label, r.wall_time_s, 2 * res.num_nodes, series,
+               _errors(r, *_branches(counts, columns), _most_cracks(counts, columns), tip_x), info)
 
 
 def _summary(study: str, runs: Sequence[Run]) -> Run:
@@ -240,6 +249,7 @@ def _summary(study: str, runs: Sequence[Run]) -> Run:
     change = abs(diss[-1] - diss[-2]) / diss[-1] if len(runs) >= 2 and diss[-1] > 0 else float("nan")
     return Run(study, float(sum(r.wall_time_s for r in runs)), max(r.n_dofs for r in runs),
                series={"branches": {key(r): r.errors["branches"] for r in runs},
+                       "most_cracks": {key(r): r.errors["most_cracks"] for r in runs},
                        "dissipated_end": {key(r): d for r, d in zip(runs, diss)},
                        "wall_time_s": {key(r): r.wall_time_s for r in runs},
                        "dissipation_history": {key(r): {"time_us": r.series["time_us"],
@@ -303,6 +313,7 @@ def _damage_map(ax, r: Run, key: str = "damaged_D"):
     ax.set_aspect("equal")
     ax.set_xticks([0, 0.025, 0.05, 0.075, 0.1])
     ax.set_yticks([0, 0.02, 0.04])
+    dyn.label_map_axes(ax)
     return m
 
 
@@ -311,8 +322,10 @@ def _title(r: Run) -> str:
     bx = e["branch_x"]
     split = f", splits at x = {1e3 * bx:.0f} mm" if bx is not None and np.isfinite(bx) else ""
     size = f"{r.info['cells']:,} cells" if "cells" in r.info else f"{r.info['nx']} x {r.info['ny']} particles"
-    return (f"h = {1e3 * r.info['h']:.3f} mm ({size}): {e['branches']} "
-            f"branch(es){split}, dissipated {e['dissipated_end']:.3f} J/m")
+    window = f"x = {1e3 * BRANCH_WINDOW[0]:.0f}-{1e3 * BRANCH_WINDOW[1]:.0f} mm"
+    return (f"h = {1e3 * r.info['h']:.3f} mm ({size}), dissipated {e['dissipated_end']:.3f} J/m\n"
+            f"{e['branches']} crack(s) across {window}, {e['most_cracks']} side by side over "
+            f"{1e3 * SIDE_BY_SIDE:.0f} mm{split}")
 
 
 def plot(results: Results, out: Path) -> list[Path]:
@@ -329,7 +342,7 @@ def plot(results: Results, out: Path) -> list[Path]:
         if not runs:
             continue
         what = ("crack opening", "crack opening $w / w_c$") if key == "damaged_w" else ("damage", "damage D")
-        fig, axes = plt.subplots(len(runs), 1, figsize=(7.6, 2.5 * len(runs) + 0.7), squeeze=False,
+        fig, axes = plt.subplots(len(runs), 1, figsize=(7.6, 2.9 * len(runs) + 0.8), squeeze=False,
                                  layout="constrained")
         for ax, r in zip(axes[:, 0], runs):
             m = _damage_map(ax, r, key)

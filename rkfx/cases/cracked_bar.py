@@ -129,18 +129,18 @@ BAR_BYTES_PER_NODE = 100e3
 BAR_BYTES_PER_NODE_STEP = 1e3
 
 PARAMS = {
-    "E": Param(2.0e6, "Young's modulus"),
-    "GF": Param(1.885, "fracture energy G_F (per crack area)"),
-    "ft": Param(200.0, "tensile strength f_t (kappa0 = ft / E)"),
-    "L": Param(100.0, "bar length"),
-    "A": Param(10.0, "cross-section area"),
-    "nodes": Param([16, 32, 64, 128], "nodes along the bar axis (even: x = L/2 between two node columns)",
+    "E": Param(2.0e6, "Young's modulus [stress]"),
+    "GF": Param(1.885, "fracture energy G_F per crack area [force / length]"),
+    "ft": Param(200.0, "tensile strength f_t [stress] (kappa0 = ft / E)"),
+    "L": Param(100.0, "bar length [length]"),
+    "A": Param(10.0, "cross-section area [length^2]"),
+    "nodes": Param([16, 32, 64, 128], "nodes along the bar axis [count] (even: x = L/2 between two node columns)",
                    fingerprint=False),
-    "weak_factor": Param(0.999, "kappa0 multiplier of the particles at x = L/2"),
-    "steps": Param(100, "load steps from the elastic limit to u_end"),
-    "u_end": Param(1.02, "last tip displacement / w_c"),
-    "stress_at": Param(0.2, "Fig 4.11 snapshot: u_T = u_peak + stress_at (w_c - u_peak)"),
-    "support_factor": Param(1.5, "RK support radius / nodal spacing"),
+    "weak_factor": Param(0.999, "kappa0 multiplier of the particles at x = L/2 [-]"),
+    "steps": Param(100, "load steps from the elastic limit to u_end [count]"),
+    "u_end": Param(1.02, "last tip displacement / w_c [-]"),
+    "stress_at": Param(0.2, "Fig 4.11 snapshot: u_T = u_peak + stress_at (w_c - u_peak) [-]"),
+    "support_factor": Param(1.5, "RK support radius / nodal spacing [-]"),
     "cells": Param(list(CELLS), "SCNI nodal cells of the regularized model: voronoi, median-dual", fingerprint=False),
 }
 QUICK = {"nodes": [16, 32], "cells": ["voronoi"], "steps": 60}

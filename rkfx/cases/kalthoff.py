@@ -78,22 +78,22 @@ EXPERIMENT_ANGLE = 70.0
 
 PARAMS = {
     "E": Param(1.9e11, "Young's modulus [Pa]"),
-    "nu": Param(0.3, "Poisson's ratio"),
+    "nu": Param(0.3, "Poisson's ratio [-]"),
     "rho": Param(8000.0, "density [kg/m^3]"),
     "ft": Param(9.5e8, "tensile strength f_t [Pa]"),
     "GF": Param(2.0e4, "fracture energy G_F [N/m]"),
     "v0": Param(16.5, "impact velocity [m/s]"),
     "t_end": Param(80e-6, "end time [s]"),
-    "tol": Param(0.3, "particle tracking tolerance of (4.22), in (0, 1]"),
-    "nodes": Param([150, 250, 350, 450], "particles per side of the regularized models"),
-    "unregularized_nodes": Param([150, 250, 350], "particles per side of the constant-kappa_c models"),
-    "no_tracking_nodes": Param([150, 250], "particles per side of the models without tracking", fingerprint=False),
-    "fem_nodes": Param([150, 250], "crack-band FEM: element size 0.1 / (n - 1)", fingerprint=False),
-    "support_factor": Param(1.75, "RK support radius / nodal spacing (>= 1.6: see the module docstring)"),
-    "courant": Param(0.5, "dt = courant * h / c_d, in (0, 1]"),
-    "radius": Param(3.5, "tracking neighbourhood radius / nodal spacing, >= 1"),
+    "tol": Param(0.3, "particle tracking tolerance of (4.22) [-], in (0, 1]"),
+    "nodes": Param([150, 250, 350, 450], "particles per side of the regularized models [count] (nx x ny: see grid)"),
+    "unregularized_nodes": Param([150, 250, 350], "particles per side of the constant-kappa_c models [count]"),
+    "no_tracking_nodes": Param([150, 250], "particles per side of the models without tracking [count]", fingerprint=False),
+    "fem_nodes": Param([150, 250], "crack-band FEM: n [count], element size 0.1 m / (n - 1)", fingerprint=False),
+    "support_factor": Param(1.75, "RK support radius / nodal spacing [-] (>= 1.6: see the module docstring)"),
+    "courant": Param(0.5, "dt = courant * h / c_d [-], in (0, 1]"),
+    "radius": Param(3.5, "tracking neighbourhood radius / nodal spacing [-], >= 1"),
     "forward": Param(True, "tracking: candidates only ahead of their particle (false: (4.22) both ways)"),
-    "eps_p": Param(1.0, "weight of the MSCNI stabilization, >= 0 (0: plain SCNI)"),
+    "eps_p": Param(1.0, "weight of the MSCNI stabilization [-], >= 0 (0: plain SCNI)"),
     "angle_radius": Param(0.1, "crack-angle fit: cracked particles within this distance of the tip [m]",
                           fingerprint=False),
 }
@@ -271,6 +271,7 @@ def _decorate(ax, r: Run, title: str):
     ax.legend(fontsize=7, loc="upper left")  # the spurious damage of Fig 4.16 lies bottom right
     ax.set_xticks([0, 0.05, 0.1])
     ax.set_yticks([0, 0.05, 0.1])
+    dyn.label_map_axes(ax)
 
 
 def plot(results: Results, out: Path) -> list[Path]:
@@ -301,7 +302,8 @@ def plot(results: Results, out: Path) -> list[Path]:
         files.append(_cli.save(fig, out / f"{fname}.png"))
     fem = sorted((r for r in results.runs if r.info.get("study") == "fem"), key=lambda r: r.info["nodes"])
     if fem:
-        fig, axes = plt.subplots(1, len(fem), figsize=(3.9 * len(fem) + 1.0, 4.0), squeeze=False)
+        fig, axes = plt.subplots(1, len(fem), figsize=(3.9 * len(fem) + 1.0, 4.4), squeeze=False,
+                                 layout="constrained")
         for ax, r in zip(axes[0], fem):
             v = np.asarray(r.series["vertices"])
             m = ax.tripcolor(v[:, 0], v[:, 1], np.asarray(r.series["triangles"]), facecolors=np.asarray(

@@ -64,11 +64,11 @@ PARAMS = {
     "a": Param(1.0, "hole radius [m]"),
     "L": Param(5.0, "side of the quarter plate [0, L]^2 [m]"),
     "h": Param(0.5, "mesh size at the outer corners on the coarsest level (h/3 on the hole) [m]"),
-    "levels": Param(4, "number of meshes, h halved each time, >= 1"),
+    "levels": Param(4, "number of meshes [count], h halved each time, >= 1"),
     "rules": Param(["mscni"], "RKPM domain integration rules: mscni, scni, dni, gauss1, gauss2, gauss4"),
     "support_factor": Param(1.5, "RK support radius / nodal spacing [-], > 1"),
     "bc_method": Param("nitsche", "RKPM essential conditions: nitsche or transformation"),
-    "fem_degrees": Param([1, 2], "FEM Lagrange degrees: 1, 2 or 3"),
+    "fem_degrees": Param([1, 2], "FEM Lagrange degrees [-]: 1, 2 or 3"),
 }
 QUICK = {"h": 0.5, "levels": 1}
 

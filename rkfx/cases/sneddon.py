@@ -83,16 +83,16 @@ PARAMS = {
     "p": Param(1.0e-4, "pressure on the crack faces [Pa]"),
     "L": Param(4.0, "side of the fixed square [m]"),
     "c": Param(0.5, "half-length of the crack [m]"),
-    "crack_particles": Param([9, 19, 39, 79], "RKPM levels: particle columns along the crack, odd (h = 2c / n)",
+    "crack_particles": Param([9, 19, 39, 79], "RKPM levels: particle columns along the crack [count], odd (h = 2c / n)",
                              fingerprint=False),
     "bands": Param(["strip", "supports"], "which particles form the smeared crack: strip, supports, row",
                    fingerprint=False),
     "support_factor": Param(1.5, "RK support radius / particle spacing [-], > 1"),
     "residual": Param(1e-6, "stiffness fraction 1 - D left in the crack's particles [-], in (0, 1)"),
-    "fem_degrees": Param([1, 2], "FEM Lagrange degrees of the slit: 1, 2 or 3", fingerprint=False),
+    "fem_degrees": Param([1, 2], "FEM Lagrange degrees of the slit [-]: 1, 2 or 3", fingerprint=False),
     "fem_h": Param(0.2, "FEM element size away from the tips on the coarsest level [m]"),
     "fem_tip": Param(0.02, "FEM element size at the tips on the coarsest level [m]"),
-    "fem_levels": Param(4, "FEM levels, both sizes halved each time, >= 1"),
+    "fem_levels": Param(4, "FEM levels [count], both sizes halved each time, >= 1"),
 }
 QUICK = {"crack_particles": [9, 19], "fem_levels": 2}
 

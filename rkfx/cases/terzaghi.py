@@ -72,15 +72,15 @@ PARAMS = {
     "W": Param(3.0, "width of the column [m]"),
     "H": Param(10.0, "height of the layer [m]"),
     "q": Param(1.0e3, "load on the top [Pa]"),
-    "nx": Param(7, "nodes across the width"),
-    "ny": Param(21, "nodes along the height"),
+    "nx": Param(7, "nodes across the width [count]"),
+    "ny": Param(21, "nodes along the height [count]"),
     "dt": Param(1.0, "first time step [s]"),
     "t_end": Param(1.0, "last output time [s] (always an output)"),
     "t_out": Param([], "further output times [s]"),
     "growth": Param(1.5, "step growth factor every 10 steps after the first [-]"),
     "variants": Param(list(VARIANTS), "RKPM variants", fingerprint=False),
     "fem": Param(list(FEM_ELEMENTS), "FEM elements: taylor-hood, q1q1, q1q1-fpp", fingerprint=False),
-    "refine_ny": Param([21, 41, 81], "nodes along the height of the refinement study", fingerprint=False),
+    "refine_ny": Param([21, 41, 81], "nodes along the height of the refinement study [count]", fingerprint=False),
     "support_factor": Param(1.5, "RK support radius / nodal spacing [-], > 1"),
 }
 QUICK = {"refine_ny": [21, 41], "fem": ["taylor-hood", "q1q1-fpp"]}
@@ -233,7 +233,7 @@ def plot(results: Results, out: Path) -> list[Path]:
     files = []
     runs = [r for r in results.runs if r.info["study"] == "variants"]
     if runs:
-        fig, axes = plt.subplots(1, 2, figsize=(12, 5.5))
+        fig, axes = plt.subplots(1, 2, figsize=(12, 6.2), layout="constrained")
         z = np.asarray(runs[0].series["z"]) / H
         for ax, zoom in zip(axes, (False, True)):
             ax.plot(np.asarray(runs[0].series["p_exact"][0]) / p0, z, color="k", lw=2.5, alpha=0.4, label="exact")
@@ -249,13 +249,13 @@ def plot(results: Results, out: Path) -> list[Path]:
                 ax.set_title("near the drained top")
             else:
                 ax.set_title(f"whole column, t = {prm['dt']:g} s (first step)")
-                ax.legend(fontsize=7)
+        # Below the panels: the oscillating profiles fill the whole column.
+        fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=4, fontsize=7)
         fig.suptitle(f"Terzaghi, {prm['nx']} x {prm['ny']} nodes: pressure after the first step "
                      f"(c_v dt / h^2 = {prm['c_v'] * prm['dt'] / (H / (prm['ny'] - 1)) ** 2:.1e})")
-        fig.tight_layout()
         files.append(_cli.save(fig, out / "first_step.png"))
         if len(runs[0].series["t"]) > 1:
-            fig, ax = plt.subplots(figsize=(6.5, 5.5))
+            fig, ax = plt.subplots(figsize=(8.5, 5.5), layout="constrained")
             ts = runs[0].series["t"]
             colors = plt.cm.viridis(np.linspace(0, 0.85, len(ts)))
             best = [r for r in runs if r.method in ("rkpm-scni+fpp", "fem-taylor-hood")] or runs[:1]
@@ -268,9 +268,8 @@ def plot(results: Results, out: Path) -> list[Path]:
             ax.set_xlabel("p / p0 [-]")
             ax.set_ylabel("y / H [-]")
             ax.set_title("consolidation: lines exact, markers numerical")
-            ax.legend(fontsize=7)
+            fig.legend(*ax.get_legend_handles_labels(), fontsize=7, loc="outside right upper")
             ax.grid(alpha=0.3)
-            fig.tight_layout()
             files.append(_cli.save(fig, out / "consolidation.png"))
     ref = [r for r in results.runs if r.info["study"] == "refinement"]
     if ref:

@@ -1,0 +1,47 @@
+"""The parameters every case declares: units in their docs, aliases on the command line."""
+import re
+
+import pytest
+
+from rkfx.cases import _cli
+from rkfx.cases._cli import Param, ParameterError, build_parser, fingerprint, parse_params
+
+CASES = ["mandel", "terzaghi", "strip_load", "plate_with_hole", "cracked_bar", "kalthoff", "crack_branching",
+         "sneddon", "injection"]
+UNIT = re.compile(r"\[[^\]]+\]")  # [Pa], [m], [-] (dimensionless), [count], [stress], ...
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_every_parameter_doc_names_its_unit(case):
+    module = __import__(f"rkfx.cases.{case}", fromlist=["PARAMS"])
+    missing = [k for k, v in module.PARAMS.items() if not isinstance(v.default, (str, bool))
+               and not (isinstance(v.default, list) and v.default and isinstance(v.default[0], str))
+               and not UNIT.search(v.doc)]
+    assert not missing, f"{case}: parameters without a unit in brackets: {missing}"
+
+
+SPECS = {"h": Param([8e-4, 4e-4], "particle spacings [m]", aliases=("spacing",)),
+         "steps": Param(10, "load steps [count]")}
+
+
+def test_an_alias_sets_its_parameter(capsys):
+    params = parse_params(SPECS, ["spacing=1e-3,5e-4"])
+    assert params == {"h": [1e-3, 5e-4], "steps": 10}
+    assert "alias of h" in capsys.readouterr().err
+
+
+def test_unknown_names_stay_one_line_errors():
+    with pytest.raises(ParameterError, match=r"unknown parameter 'nodes'; valid names: h, steps"):
+        parse_params(SPECS, ["nodes=3"])
+
+
+def test_help_lists_the_aliases_and_the_fingerprint_uses_the_parameter_name():
+    assert "alias spacing" in build_parser("demo", "demo", SPECS).epilog
+    stamp = fingerprint("demo", SPECS, parse_params(SPECS, ["spacing=1e-3"]), "rkpm")
+    assert stamp["params"] == {"h": [1e-3], "steps": 10}
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_no_alias_hides_a_parameter(case):
+    module = __import__(f"rkfx.cases.{case}", fromlist=["PARAMS"])
+    assert not set(_cli.alias_names(module.PARAMS)) & set(module.PARAMS)
