@@ -30,6 +30,7 @@ linear solves take a communicator.
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -75,6 +76,10 @@ class CrackBandResult:
         wall_time_s: Wall time of the load path (mesh, forms and solves) [s].
         iterations: Newton iterations over all steps.
         cuts: Step cuts.
+        snapshots: Requested tip displacement -> (stress (num_cells, 3) [Pa], damage
+            (num_cells,), u_T reached [m]).
+        vertices, cells: The mesh, shape ``(num_vertices, 2)`` [m] and ``(num_cells, 3)``;
+            cell_dofs: the element (DG0 dof, the index of ``x`` and the snapshots) of each cell.
     """
 
     elements: int
@@ -93,6 +98,10 @@ class CrackBandResult:
     iterations: int = 0
     cuts: int = 0
     timings: dict[str, float] = field(default_factory=dict)
+    snapshots: dict = field(default_factory=dict)
+    vertices: np.ndarray | None = None
+    cells: np.ndarray | None = None
+    cell_dofs: np.ndarray | None = None
 
 
 class CrackBandModel(DamageHistory):
@@ -129,7 +138,7 @@ class CrackBandModel(DamageHistory):
             raise InputError(f"crack band h = {h:.3g} is too wide for G_F: w_c / h = {kappa_c:.3g} <= kappa0 = "
                              f"{material.kappa0:.3g}; use more elements (h < 2 E G_F / f_t^2)")
         self.elements, self.h, self.thickness = n_el, h, A / h
-        mesh = dolfinx.mesh.create_rectangle(MPI.COMM_SELF, [np.array([0.0, 0.0]), np.array([L, h])], [n_el, 1],
+        self.mesh = mesh = dolfinx.mesh.create_rectangle(MPI.COMM_SELF, [np.array([0.0, 0.0]), np.array([L, h])], [n_el, 1],
                                              dolfinx.mesh.CellType.triangle)
         V = dolfinx.fem.functionspace(mesh, ("Lagrange", 1, (2,)))
         Q = dolfinx.fem.functionspace(mesh, ("DG", 0, (3,)))
@@ -154,6 +163,7 @@ class CrackBandModel(DamageHistory):
         xc = dolfinx.fem.Function(Q0)
         xc.interpolate(dolfinx.fem.Expression(ufl.SpatialCoordinate(mesh)[0], Q0.element.interpolation_points))
         self.x_cells = xc.x.array.copy()
+        self.cell_dofs = Q0.dofmap.list[:, 0].copy()  # the DG0 dof of each cell
         weak = np.abs(self.x_cells - 0.5 * L) < 0.5 * h
         self._start_history(dm.damage_model(material, volume, np.where(weak, weak_factor, 1.0), kappa_c=kappa_c,
                                             regularized=False))
@@ -194,7 +204,8 @@ class CrackBandModel(DamageHistory):
 def solve_crack_band(L: float, A: float, E: float, GF: float, ft: float, elements: int,
                      targets: np.ndarray, weak_factor: float = 0.999, u_profile: float | None = None,
                      rtol: float = 1e-10, max_iterations: int = 24, comm=MPI.COMM_SELF, checkpoint_every: int = 0,
-                     checkpoint_dir: Path | None = None, resume: Path | None = None) -> CrackBandResult:
+                     checkpoint_dir: Path | None = None, resume: Path | None = None,
+                     snapshots: Sequence[float] = ()) -> CrackBandResult:
     """Crack-band FEM load path of the bar through the tip displacements ``targets``.
 
     Args:
@@ -210,6 +221,8 @@ def solve_crack_band(L: float, A: float, E: float, GF: float, ft: float, element
         comm: Communicator of the linear solves.
         checkpoint_every, checkpoint_dir, resume: Checkpoints every so many accepted steps
             into ``checkpoint_dir``; continue from the checkpoint folder ``resume``.
+        snapshots: Further tip displacements [m] at which stress and damage are kept (each one
+            is also a target of the path: give some of ``targets`` to leave the path as it is).
 
     Raises:
         InputError: Bad element count or a band too wide for G_F (w_c / h <= kappa0).
@@ -217,9 +230,9 @@ def solve_crack_band(L: float, A: float, E: float, GF: float, ft: float, element
     t_start = time.perf_counter()
     model = CrackBandModel(L, A, E, GF, ft, elements, weak_factor)
     u_profile = float(targets[-1] if u_profile is None else u_profile)
-    curve = LoadCurve(model, model.thickness, model.h, [u_profile])
+    curve = LoadCurve(model, model.thickness, model.h, sorted({u_profile, *map(float, snapshots)}))
     t_setup = time.perf_counter()
-    out = march(model, np.unique(np.r_[np.asarray(targets, float), u_profile]),
+    out = march(model, np.unique(np.r_[np.asarray(targets, float), u_profile, np.asarray(snapshots, float)]),
                 QuasiStatic(NewtonOptions(max_iterations=max_iterations), rtol=rtol), recorder=curve, comm=comm,
                 checkpoint_every=checkpoint_every, checkpoint_dir=checkpoint_dir, resume=resume)
     c = curve.series()
@@ -231,4 +244,6 @@ def solve_crack_band(L: float, A: float, E: float, GF: float, ft: float, element
         u_profile=profile[2] if profile else float(c["u"][-1]),
         u_T_max=dm.failure_displacement(c["u"], c["force"]), n_dofs=model.n_dofs,
         wall_time_s=t_setup - t_start + out.wall_time_s, iterations=out.iterations, cuts=out.cuts,
-        timings={"setup": t_setup - t_start, "path": out.wall_time_s})
+        timings={"setup": t_setup - t_start, "path": out.wall_time_s}, snapshots=dict(curve.snapshots),
+        vertices=model.mesh.geometry.x[:, :2].copy(), cells=model.mesh.geometry.dofmaps[0].copy(),
+        cell_dofs=model.cell_dofs)

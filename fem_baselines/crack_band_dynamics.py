@@ -417,6 +417,8 @@ def _crack_band(mesh, material: dm.DamageMaterial, rho: float, t_end: float, reg
         with np.load(done / MESH_FILE) as z:
             x, tri, h = z["x"], z["triangles"], float(z["h"])
         run = DamageRun.load(done / "result.npz")
+        if io.get("frames") is not None:
+            io["frames"](x, tri).last(run)
         return DynamicCrackBandResult(len(x), len(tri), h, run, x[tri].mean(axis=1), x, tri,
                                       time.perf_counter() - wall)
     m = mesh()
@@ -432,10 +434,12 @@ def _crack_band(mesh, material: dm.DamageMaterial, rho: float, t_end: float, reg
     model = dm.damage_model(material, ops.area, geometry=triangle_geometry(m.vertices) if regularized else None,
                             kappa_c=kappa_c, regularized=regularized, band_factor=2.0)
     constraints, external_force = conditions(m, ops)
+    frames = io.get("frames")
     run = run_damage(label, CellStrain(ops), ops.mass, dt, model, None, constraints, t_end, external_force,
                      samples=samples, checkpoint_every=io.get("checkpoint_every", 0),
                      work_dir=None if work_dir is None else Path(work_dir),
-                     resume=None if resume is None else Path(resume))
+                     resume=None if resume is None else Path(resume),
+                     frames=None if frames is None else frames(m.x, m.triangles))
     if work_dir is not None:  # beside result.npz, so that a resume reads the run back without meshing
         folder = Path(work_dir) / run_folder(label)
         folder.mkdir(parents=True, exist_ok=True)  # a run read back from elsewhere wrote nothing here
@@ -449,7 +453,7 @@ def kalthoff_crack_band(h: float, t_end: float = 80e-6, *, E: float = 1.9e11, nu
                         side: float = 0.1, a1: float = 0.05, a2: float = 0.025, regularized: bool = True,
                         kappa_c: float | None = None, courant: float = 0.5, samples: int = 200,
                         label: str | None = None, checkpoint_every: int = 0, work_dir: str | Path | None = None,
-                        resume: str | Path | None = None, comm: MPI.Comm = MPI.COMM_SELF
+                        resume: str | Path | None = None, comm: MPI.Comm = MPI.COMM_SELF, frames=None
                         ) -> DynamicCrackBandResult:
     """Run Kalthoff's impact problem with explicit crack-band finite elements (module doc).
 
@@ -468,6 +472,8 @@ def kalthoff_crack_band(h: float, t_end: float = 80e-6, *, E: float = 1.9e11, nu
         label, checkpoint_every, work_dir, resume: As for ``rkfx.models.damage_dynamics.run_damage``
             (default label ``fem-crack-band h=<h>``).
         comm: Communicator; rank 0 computes and broadcasts the result.
+        frames: ``frames(x, triangles)`` gives the ``rkfx.models.damage_dynamics.Frames`` that
+            receive the fields through time on the mesh (``None``: none are written).
 
     Returns:
         The run's result on every rank of ``comm``.
@@ -491,7 +497,7 @@ def kalthoff_crack_band(h: float, t_end: float = 80e-6, *, E: float = 1.9e11, nu
             return [Constraint(_identity_rows(2 * bottom + 1, n2)),
                     Constraint(_identity_rows(2 * impact, n2), velocity=lambda t: v_impact)], None
 
-        io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume}
+        io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume, "frames": frames}
         return _crack_band(mesh, material, rho, t_end, regularized, kappa_c, courant, samples,
                            label or f"fem-crack-band h={h:g}", conditions, io, wall)
 
@@ -521,7 +527,7 @@ def branching_crack_band(h: float, t_end: float = 80e-6, *, E: float = 3.2e10, n
                          a2: float = 0.02, regularized: bool = True, kappa_c: float | None = None,
                          courant: float = 0.5, samples: int = 200, label: str | None = None,
                          checkpoint_every: int = 0, work_dir: str | Path | None = None,
-                         resume: str | Path | None = None, comm: MPI.Comm = MPI.COMM_SELF
+                         resume: str | Path | None = None, comm: MPI.Comm = MPI.COMM_SELF, frames=None
                          ) -> DynamicCrackBandResult:
     """Run the crack-branching plate (seed 4.3.3) with explicit crack-band finite elements: an
     edge slit along y = a2 from x = 0 to a1, a step traction ``sigma`` [Pa] on the top and
@@ -543,7 +549,7 @@ def branching_crack_band(h: float, t_end: float = 80e-6, *, E: float = 3.2e10, n
             f = edge_traction(m, sigma)
             return [], lambda t: f
 
-        io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume}
+        io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume, "frames": frames}
         return _crack_band(mesh, material, rho, t_end, regularized, kappa_c, courant, samples,
                            label or f"fem-crack-band h={h:g}", conditions, io, wall)
 

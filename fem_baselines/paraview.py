@@ -12,8 +12,12 @@ complete after every step, so a run that stops keeps every step it wrote.
 """
 from pathlib import Path
 
+import numpy as np
+
 import dolfinx_solver  # noqa: F401  (MPI first)
 from dolfinx import fem, io
+
+from rkfx.output.paraview import file_stem
 
 
 class FemSeries:
@@ -23,18 +27,21 @@ class FemSeries:
         folder: Output folder (created on rank 0).
         name: File name without suffix, e.g. the run's method label.
         mesh: The dolfinx mesh the functions live on.
+        times: The times to keep [s]: a ``write`` at any other time is skipped (a solver that
+            records every step writes only these). ``None``: every write is kept.
     """
 
-    def __init__(self, folder, name: str, mesh):
+    def __init__(self, folder, name: str, mesh, times=None):
         folder = Path(folder)
         if mesh.comm.rank == 0:
             folder.mkdir(parents=True, exist_ok=True)
         mesh.comm.barrier()
-        self.path = folder / f"{str(name).replace('/', '-')}.pvd"
+        self.path = folder / f"{file_stem(name)}.pvd"
         self.mesh = mesh
         self._file = io.VTKFile(mesh.comm, str(self.path), "w")
         self._spaces: dict[tuple, fem.FunctionSpace] = {}
         self._out: dict[str, fem.Function] = {}
+        self.times = None if times is None else np.asarray(times, float)
 
     def _target(self, key: str, f: fem.Function) -> fem.Function:
         """The vertex (P1) or cell (DG0) function ``f`` is written through."""
@@ -50,7 +57,9 @@ class FemSeries:
         return self._out[key]
 
     def write(self, time: float, **functions: fem.Function) -> None:
-        """Write the functions at ``time`` [s]."""
+        """Write the functions at ``time`` [s] (unless ``times`` leaves it out)."""
+        if self.times is not None and not np.any(np.isclose(time, self.times, rtol=1e-9, atol=0.0)):
+            return
         out = []
         for key, f in functions.items():
             out.append(self._target(key, f))

@@ -559,6 +559,7 @@ def solve_biot(
     checkpoint_dir: str | Path | None = None,
     resume: str | Path | None = None,
     vtk=None,
+    progress: Callable | None = None,
 ) -> BiotResult:
     """Solve plane-strain Biot consolidation with backward Euler and a monolithic u-p solve.
 
@@ -602,6 +603,7 @@ def solve_biot(
             equals that of an uninterrupted run.
         vtk: A ``fem_baselines.paraview.FemSeries`` on ``mesh`` that receives u and p at the
             output times (a resumed run writes the times after its checkpoint), or ``None``.
+        progress: Optional wrapper of the step iterator (a progress bar).
 
     Returns:
         The sampled history and final fields; see :class:`BiotResult`.
@@ -648,7 +650,8 @@ def solve_biot(
     solves = Factorizations(comm, "mumps", keep=2, mumps_icntl=_MUMPS_ICNTL, reuse_analysis=True)
     try:
         run = integrate(backward_euler(), model, times, start=start, recorder=kept, solves=solves, max_cuts=0,
-                        checkpoint_every=checkpoint_every, checkpoint_dir=checkpoint_dir, resume=resume)
+                        checkpoint_every=checkpoint_every, checkpoint_dir=checkpoint_dir, resume=resume,
+                        progress=progress)
     finally:
         solves.destroy()
     model.assign(run.state.x, uh, ph)

@@ -32,7 +32,7 @@ def summary(res, name):
 
 def test_crack_angle_between_60_and_75_degrees_at_every_refinement(quick):
     runs = study(quick, "rkpm-dpm")
-    assert sorted(runs) == kalthoff.QUICK["nodes"]
+    assert sorted(runs) == kalthoff.columns(kalthoff.QUICK["h"]) == [60, 90, 120]
     for n, r in runs.items():
         assert 60.0 <= r.errors["crack_angle_deg"] <= 75.0, (n, r.errors["crack_angle_deg"])
         # The crack reached the top half of the plate: it grew, it did not just initiate.
@@ -69,7 +69,7 @@ def test_tracking_off_lets_spurious_damage_appear(quick):
 @pytest.mark.skipif("fem" not in METHODS, reason="needs dolfinx")
 def test_crack_band_fem_runs_beside_rkpm(quick):
     fem = study(quick, "fem")
-    assert sorted(fem) == kalthoff.QUICK["fem_nodes"]
+    assert sorted(fem) == kalthoff.columns(kalthoff.QUICK["fem_h"])
     for r in fem.values():
         assert r.errors["dissipated_end"] > 0
         assert np.isfinite(r.errors["crack_angle_deg"])
@@ -110,7 +110,8 @@ def test_cli_writes_metrics_and_rejects_bad_input(tmp_path, capsys):
     assert {"crack_angle_deg", "dissipated_end", "cracked_below_crack_plane"} <= set(run["errors"])
     assert (out / "checkpoints" / "rkpm-dpm_n40" / "result.npz").is_file()
     assert (out / "damage.png").is_file() and (out / "cracks.png").is_file()
-    for bad in (["--set", "nodes=10"], ["--set", "GF=-1"], ["--resume", str(tmp_path / "nowhere")]):
+    capsys.readouterr()
+    for bad in (["--set", "h=0.01"], ["--set", "GF=-1"], ["--resume", str(tmp_path / "nowhere")]):
         with pytest.raises(SystemExit) as err:
             kalthoff.main(["--method", "rkpm", "--out", str(tmp_path / "x"), *bad])
         assert err.value.code == 2

@@ -45,3 +45,26 @@ def test_help_lists_the_aliases_and_the_fingerprint_uses_the_parameter_name():
 def test_no_alias_hides_a_parameter(case):
     module = __import__(f"rkfx.cases.{case}", fromlist=["PARAMS"])
     assert not set(_cli.alias_names(module.PARAMS)) & set(module.PARAMS)
+
+
+def test_a_converting_alias_gives_its_parameter_the_value_in_its_own_terms(capsys):
+    from rkfx.cases import kalthoff
+
+    params = parse_params(kalthoff.PARAMS, ["nodes=150,250"])
+    assert params["h"] == pytest.approx([0.1 / 149, 0.1 / 249]) and kalthoff.columns(params["h"]) == [150, 250]
+    assert "alias of h" in capsys.readouterr().err
+    assert parse_params(kalthoff.PARAMS)["h"] == kalthoff.spacings([150, 250, 350, 450])
+
+
+def test_a_resume_reads_runs_stored_under_an_alias(tmp_path):
+    from rkfx.cases import kalthoff
+
+    params = parse_params(kalthoff.PARAMS)
+    stamp = fingerprint("kalthoff", kalthoff.PARAMS, params, "rkpm")
+    old = {**stamp, "params": {("nodes" if k == "h" else k): ([150, 250, 350, 450] if k == "h" else v)
+                               for k, v in stamp["params"].items()}}
+    (tmp_path / "checkpoints").mkdir()
+    (tmp_path / "checkpoints" / _cli.FINGERPRINT).write_text(__import__("json").dumps(old))
+    assert _cli.check_resume(tmp_path, stamp, False, kalthoff.PARAMS)
+    with pytest.raises(ParameterError, match=r"h = .* \(now "):
+        _cli.check_resume(tmp_path, {**stamp, "params": {**stamp["params"], "h": [1e-3]}}, False, kalthoff.PARAMS)

@@ -115,3 +115,84 @@ def test_vtk_is_refused_in_one_line_by_a_case_without_paraview_output(tmp_path, 
     assert stop.value.code == 2
     err = capsys.readouterr().err.strip()
     assert "--vtk" in err and "demo" in err and len(err.splitlines()) == 1
+
+
+RK = ("displacement", "pressure", "strain", "effective_stress")
+DAMAGE = ("damage", "crack_opening", "displacement", "velocity")
+# case, --set values, {file: (point fields, cell fields)} of its --quick --vtk output
+CASE_FILES = {
+    "mandel": (["variants=scni+fpp", "early_variants=scni+fpp", "fem=taylor-hood"],
+               {"rkpm-scni+fpp_particles.pvd": (RK, ()), "rkpm-scni+fpp_cells.pvd": ((), RK),
+                "fem-taylor-hood.pvd": (("displacement", "pressure"), ())}),
+    "strip_load": (["variants=scni+fpp", "low_variants=ni", "fem=q1q1-fpp"],
+                   {"rkpm-scni+fpp_particles.pvd": (RK, ()), "rkpm-ni-low-k_cells.pvd": ((), RK),
+                    "fem-q1q1-fpp.pvd": (("displacement", "pressure"), ())}),
+    "plate_with_hole": ([], {"rkpm-mscni-level0_particles.pvd": (("displacement", "strain", "stress"), ()),
+                             "rkpm-mscni-level0_cells.pvd": ((), ("displacement", "strain", "stress")),
+                             "fem-p2-level0.pvd": (("displacement",), ())}),
+    "sneddon": (["crack_particles=9", "bands=strip", "fem_degrees=1", "fem_levels=1"],
+                {"rkpm-strip-n9_particles.pvd": (RK + ("damage", "crack_opening"), ()),
+                 "fem-p1-level0.pvd": (("displacement",), ())}),
+    "cracked_bar": (["nodes=16"], {"rkpm-scni_n16_particles.pvd": (("stress", "damage"), ()),
+                                   "rkpm-scni_n16_cells.pvd": ((), ("stress", "damage")),
+                                   "fem-crack-band_n16.pvd": ((), ("stress", "damage"))}),
+    "kalthoff": (["nodes=60", "unregularized_nodes=60", "no_tracking_nodes=60", "fem_nodes=60", "t_end=2e-5"],
+                 {"rkpm-dpm_n60_particles.pvd": (DAMAGE, ()), "rkpm-dpm_n60_cells.pvd": ((), DAMAGE),
+                  "fem-crack-band_n60.pvd": (("displacement", "velocity"), ("damage", "crack_opening"))}),
+    "crack_branching": (["h=8e-4", "unregularized_h=8e-4", "fem_h=8e-4", "t_end=1e-5", "--method", "both"],
+                        {"rkpm-dpm_h0.0008_particles.pvd": (DAMAGE, ()),
+                         "fem-crack-band_h0.0008.pvd": (("displacement", "velocity"), ("damage",))}),
+    "injection": (["h=0.05"], {"rkpm_h0.05_particles.pvd": (("displacement", "pressure", "damage", "crack_opening",
+                                                              "strain", "permeability"), ()),
+                               "rkpm_h0.05_cells.pvd": ((), ("pressure", "damage"))}),
+}
+
+
+@pytest.mark.parametrize("case", sorted(CASE_FILES))
+def test_case_vtk_files_hold_the_documented_fields(case, tmp_path, capsys):
+    """Each case's --quick --vtk output opens in pyvista with the fields its docstring names, at
+    increasing times, and the nodal cells tile the model; its terminal output fits 100 columns."""
+    import importlib
+
+    pytest.importorskip("dolfinx_solver")
+    sets, files = CASE_FILES[case]
+    method = sets[sets.index("--method"):] if "--method" in sets else []
+    sets = [s for s in sets if s not in method]
+    module = importlib.import_module(f"rkfx.cases.{case}")
+    out = tmp_path / case
+    assert module.main(["--quick", "--vtk", "--out", str(out), *method, *(["--set", *sets] if sets else [])]) == 0
+    printed = capsys.readouterr()
+    table = printed.out.split("\nresults: ")[0]  # the file paths below it are as long as they are
+    assert max(map(len, table.splitlines())) <= 100
+    assert "done [" in printed.err  # a line per finished model
+    for name, (point, cell) in files.items():
+        pvd = out / "vtk" / name
+        times = times_of(pvd)
+        assert len(times) >= 1 and np.all(np.diff(times) > 0), (name, times)
+        _, mesh = _read(pvd, times[-1])
+        assert set(point) <= set(mesh.point_data.keys()), (name, mesh.point_data.keys())
+        assert set(cell) <= set(mesh.cell_data.keys()), (name, mesh.cell_data.keys())
+        for data in (mesh.point_data, mesh.cell_data):
+            if "damage" in data:
+                assert 0.0 <= data["damage"].min() and data["damage"].max() <= 1.0
+            for key in data.keys():
+                assert np.isfinite(data[key]).all(), (name, key)
+    cells = next(out.glob("vtk/*_cells.pvd"), None)
+    if cells is not None and case != "plate_with_hole":  # the rectangular models: cells tile the box
+        _, mesh = _read(cells, times_of(cells)[-1])
+        lo, hi = np.asarray(mesh.bounds[::2][:2]), np.asarray(mesh.bounds[1::2][:2])
+        assert mesh.area == pytest.approx(np.prod(hi - lo), rel=1e-9)
+
+
+def test_render_draws_a_field_off_screen_and_names_the_missing_one(tmp_path):
+    from rkfx.output.render import render
+
+    p = structured(1.0, 1.0, 9, 9)
+    series = FieldSeries(tmp_path, "run", p.x, cells=nodal_cells(p))
+    series.write(1.0, damage=(p.x[:, 0] > 0.5).astype(float))
+    png = render(tmp_path / "run_cells.pvd", "damage", tmp_path / "damage.png", segments=[((0, 0.5), (0.5, 0.5))])
+    image = pv.read(str(png))
+    rgb = np.asarray(image.point_data[image.point_data.keys()[0]])[:, :3].astype(float)
+    assert rgb.std(axis=0).max() > 20  # not one flat colour: the damaged half shows
+    with pytest.raises(InputError, match="no field 'pressure'; choose from damage"):
+        render(tmp_path / "run_cells.pvd", "pressure", tmp_path / "x.png")

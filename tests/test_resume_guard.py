@@ -129,7 +129,7 @@ def test_a_folder_without_fingerprint_is_not_trusted(whole, tmp_path, capsys):
 def test_bad_input_leaves_no_fingerprint(tmp_path, capsys):
     out = tmp_path / "k"
     with pytest.raises(SystemExit):
-        kalthoff.main([*ARGS, "--set", "nodes=10", "--out", str(out)])
+        kalthoff.main([*ARGS, "--set", "h=0.01", "--out", str(out)])
     assert not out.exists()
     with pytest.raises(SystemExit):
         kalthoff.main([*ARGS, "--recompute", "--out", str(out)])

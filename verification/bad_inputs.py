@@ -166,7 +166,7 @@ ROWS: list[Row] = [
         setup=_stored_run("mandel", "rkpm-scni+fpp-profiles", quick=True, checkpoint=b"garbage\n"), work=True),
     # --- memory: refused before any work ---
     Row("too big for memory", "mandel", ("--set", "nx=1000000000")),
-    Row("too big for memory", "kalthoff", ("--set", "nodes=150,1000000")),
+    Row("too big for memory", "kalthoff", ("--set", "h=6.7e-4,1e-7")),
     Row("too big for memory", "crack_branching", ("--set", "h=1e-6")),
     Row("too big for memory", "cracked_bar", ("--set", "nodes=16,2000000000")),
     # --- documented ranges, case by case ---
@@ -199,10 +199,10 @@ ROWS: list[Row] = [
                                     ("support too small", "support_factor=0.5"), ("Poisson's ratio 0.5", "nu=0.5"),
                                     ("no load", "T=0")]),
     *_case_rows("kalthoff", [("support too small for the crack", "support_factor=1.5"),
-                             ("Courant number above 1", "courant=1.5"), ("too few particles", "nodes=10,150"),
+                             ("Courant number above 1", "courant=1.5"), ("too few particles", "h=0.01,6.7e-4"),
                              ("zero tracking radius", "radius=0"), ("negative stabilization", "eps_p=-1"),
                              ("Poisson's ratio above 0.5", "nu=0.6"), ("tracking tolerance above 1", "tol=1.5"),
-                             ("too coarse for the fracture energy", "GF=1 nodes=150")]),
+                             ("too coarse for the fracture energy", "GF=1 h=6.7e-4")]),
     *_case_rows("crack_branching", [("unknown plane idealization", "plane=axisymmetric"),
                                     ("tracking tolerance above 1", "tol=2"), ("spacing too coarse", "h=0.01"),
                                     ("tracking radius below 1 spacing", "radius=0.5"), ("negative stabilization", "eps_p=-0.5"),

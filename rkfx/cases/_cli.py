@@ -43,6 +43,7 @@ from typing import Any
 import numpy as np
 
 from rkfx.cases._preflight import before_work
+from rkfx.cases._terminal import _fmt_value, model_run, progress, step_progress, summary_table  # noqa: F401  (cases: _cli.*)
 from rkfx.errors import InputError, SolverError
 from rkfx.parallel.threads import share_cores
 from rkfx.solvers.checkpoint import has_checkpoint, run_folder
@@ -53,20 +54,34 @@ METHODS = {"rkpm": ("rkpm",), "fem": ("fem",), "both": ("rkpm", "fem")}
 
 
 @dataclass(frozen=True)
+class Alias:
+    """An older name of a parameter that held the value in other terms: ``--set NAME=TEXT`` reads
+    TEXT as the type of ``example`` and gives the parameter ``convert(value)``.
+
+    Example: Kalthoff's ``nodes=150`` (particles along x) is ``h=[0.1 / 149]`` (spacing [m])."""
+
+    name: str
+    example: Any
+    convert: Callable[[Any], Any]
+    doc: str
+
+
+@dataclass(frozen=True)
 class Param:
     """A documented case parameter: its default (which fixes its type) and a one-line doc.
 
     ``fingerprint=False`` marks a value that only chooses which runs exist (a list of levels or
     variants, each run stored under its own label): a resume may change it and keeps the
     stored runs. Every other value is part of the fingerprint of the stored runs.
-    ``aliases``: older names that ``--set`` still takes for this parameter (same value and
-    unit); results and fingerprints use the parameter's own name.
+    ``aliases``: older names that ``--set`` still takes for this parameter: a name (same value
+    and unit) or an ``Alias`` (a value in other terms, converted); results and fingerprints
+    use the parameter's own name, and a resume translates stored aliases the same way.
     """
 
     default: Any
     doc: str
     fingerprint: bool = True
-    aliases: tuple[str, ...] = ()
+    aliases: tuple[str | Alias, ...] = ()
 
 
 @dataclass
@@ -149,16 +164,34 @@ def parse_params(specs: Mapping[str, Param], overrides: Sequence[str] = (),
         if name not in specs and name not in names:
             raise ParameterError(f"unknown parameter {name!r}; valid names: {valid}")
         if name in names:
+            target, alias = names[name]
+            value = coerce(target, text, specs[target].default) if alias is None else \
+                alias.convert(coerce(name, text, alias.example))
             if _rank() == 0:
-                print(f"note: --set {name} is an alias of {names[name]}", file=sys.stderr)
-            name = names[name]
+                print(f"note: --set {name} is an alias of {target}" +
+                      ("" if alias is None else f" ({alias.doc}): {target}={_fmt_value(value)}"), file=sys.stderr)
+            params[target] = value
+            continue
         params[name] = coerce(name, text, specs[name].default)
     return params
 
 
-def alias_names(specs: Mapping[str, Param]) -> dict[str, str]:
-    """``{alias: parameter name}`` of the parameters' ``aliases``."""
-    return {a: k for k, v in specs.items() for a in v.aliases}
+def alias_names(specs: Mapping[str, Param]) -> dict[str, tuple[str, Alias | None]]:
+    """``{alias: (parameter name, Alias or None)}`` of the parameters' ``aliases``."""
+    return {(a.name if isinstance(a, Alias) else a): (k, a if isinstance(a, Alias) else None)
+            for k, v in specs.items() for a in v.aliases}
+
+
+def canonical(params: Mapping[str, Any], specs: Mapping[str, Param]) -> dict[str, Any]:
+    """``params`` with alias names replaced by their parameters (values converted)."""
+    names, out = alias_names(specs), {}
+    for k, v in params.items():
+        if k in names and names[k][0] not in params:
+            target, alias = names[k]
+            out[target] = v if alias is None else alias.convert(v)
+        else:
+            out[k] = v
+    return out
 
 
 class _Parser(argparse.ArgumentParser):
@@ -200,8 +233,9 @@ def build_parser(name: str, doc: str | None, specs: Mapping[str, Param],
     lines = ["parameters (--set NAME=VALUE):"]
     width = max(len(k) for k in specs) if specs else 0
     for k, v in specs.items():
-        default = ",".join(map(str, v.default)) if isinstance(v.default, (list, tuple)) else v.default
-        also = f"; alias {', '.join(v.aliases)}" if v.aliases else ""
+        default = _fmt_value(v.default)
+        also = "; alias " + ", ".join(a if isinstance(a, str) else f"{a.name}: {a.doc}" for a in v.aliases) \
+            if v.aliases else ""
         lines.append(f"  {k:<{width}}  {v.doc} (default {default}{also})")
     if quick:
         lines.append("--quick sets " + ", ".join(f"{k}={_fmt_value(v)}" for k, v in quick.items()))
@@ -252,10 +286,6 @@ class Checkpoints:
                 "resume": old if has_checkpoint(old) else None}
 
 
-def _fmt_value(v):
-    return ",".join(map(str, v)) if isinstance(v, (list, tuple)) else str(v)
-
-
 def main(name: str, doc: str | None, specs: Mapping[str, Param], run: Callable[..., Results],
          plot: Callable[[Results, Path], Sequence[Path]] | None = None, argv: Sequence[str] | None = None,
          quick: Mapping[str, Any] | None = None, checkpoints: bool = False) -> int:
@@ -293,7 +323,7 @@ def main(name: str, doc: str | None, specs: Mapping[str, Param], run: Callable[.
         check_out(args.out, raw=argv if argv is not None else sys.argv[1:])
         _report_resumes(args.resume if checkpoints else None)
         stamp = fingerprint(name, specs, params, args.method) if checkpoints else None
-        if checkpoints and args.resume is not None and not check_resume(args.resume, stamp, args.recompute):
+        if checkpoints and args.resume is not None and not check_resume(args.resume, stamp, args.recompute, specs):
             extra["resume"] = None  # --recompute: every stored run differs
             if _same(args.resume, args.out) and _rank() == 0:
                 set_aside_checkpoints(args.out)
@@ -387,11 +417,12 @@ def differences(stored: Mapping[str, Any], now: Mapping[str, Any]) -> list[str]:
     old, new = stored.get("params", {}), now["params"]
     for k in dict.fromkeys([*new, *old]):
         if k not in old or k not in new or old[k] != new[k]:
-            out.append(f"{k} = {_fmt_value(old.get(k, 'unset'))} (now {_fmt_value(new.get(k, 'unset'))})")
+            out.append(f"{k} = {_fmt_value(old.get(k, 'unset'), None)} (now {_fmt_value(new.get(k, 'unset'), None)})")
     return out
 
 
-def check_resume(resume: Path, stamp: Mapping[str, Any], recompute: bool) -> bool:
+def check_resume(resume: Path, stamp: Mapping[str, Any], recompute: bool,
+                 specs: Mapping[str, Param] | None = None) -> bool:
     """Whether the runs stored in ``resume/checkpoints`` were computed with ``stamp``; if not,
     ``False`` with ``recompute``, else a one-line error naming the differing parameters."""
     folder = Path(resume) / "checkpoints"
@@ -399,7 +430,10 @@ def check_resume(resume: Path, stamp: Mapping[str, Any], recompute: bool) -> boo
     why, fix = None, "add --recompute to compute them again"
     if path.is_file():
         try:
-            diff = differences(json.loads(path.read_text()), stamp)
+            stored = json.loads(path.read_text())
+            if specs is not None:  # runs stored under a parameter's older name
+                stored["params"] = canonical(stored.get("params", {}), specs)
+            diff = differences(stored, stamp)
         except (ValueError, AttributeError):
             diff = [f"{path} is unreadable"]
         if diff:
@@ -523,49 +557,6 @@ def write_results(results: Results, out: Path) -> Path:
     path = out / "results.json"
     path.write_text(json.dumps(jsonable(data), indent=1, allow_nan=False) + "\n")
     return path
-
-
-def summary_table(results: Results) -> str:
-    """Plain-text table: method, info scalars, dofs, wall time, errors."""
-    def keys(attr):
-        seen = {}
-        for r in results.runs:
-            for k, v in getattr(r, attr).items():
-                if np.ndim(v) == 0:
-                    seen.setdefault(k, None)
-        return list(seen)
-
-    info, errs = keys("info"), keys("errors")
-    head = ["method", *info, "dofs", "wall [s]", *errs]
-    rows = [[r.method, *(_cell(r.info.get(k)) for k in info), str(r.n_dofs), f"{r.wall_time_s:.2f}",
-             *(_cell(r.errors.get(k)) for k in errs)] for r in results.runs]
-    widths = [max(len(c) for c in col) for col in zip(head, *rows)]
-    fmt = lambda row: "  ".join(c.rjust(w) if i else c.ljust(w) for i, (c, w) in enumerate(zip(row, widths)))
-    title = f"{results.case}: " + ", ".join(f"{k}={_fmt_value(v)}" for k, v in results.params.items())
-    return "\n".join([textwrap.shorten(title, 200), fmt(head), "  ".join("-" * w for w in widths),
-                      *map(fmt, rows)])
-
-
-def _cell(v) -> str:
-    if v is None:
-        return "-"
-    if isinstance(v, (bool, np.bool_, str)):
-        return str(v)
-    if isinstance(v, (int, np.integer)):
-        return str(int(v))
-    v = float(v)
-    return "-" if not math.isfinite(v) else f"{v:.3g}"
-
-
-def progress(iterable: Iterable, desc: str = "", total: int | None = None) -> Iterable:
-    """tqdm progress bar on stderr when it is a terminal; the bare iterable otherwise."""
-    if not sys.stderr.isatty() or _rank() != 0:
-        return iterable
-    try:
-        from tqdm import tqdm
-    except ImportError:
-        return iterable
-    return tqdm(iterable, desc=desc, total=total, leave=False)
 
 
 # Line style of each method, shared by the figures of all cases: (colour, linestyle).

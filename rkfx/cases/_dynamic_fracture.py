@@ -33,7 +33,8 @@ from rkfx.geometry.nodal_domains import NodalDomains
 from rkfx.geometry.particles import Particles, graded
 from rkfx.approximation.shape_functions import RKApproximation, rk_approximation
 from rkfx.solvers.central_difference import Constraint
-from rkfx.cases import _preflight
+from rkfx.cases import _paraview, _preflight
+from rkfx.cases._terminal import model_run, step_progress
 
 CRACKED = 0.5  # w / w_c from which a particle counts as cracked (half its fracture energy spent)
 
@@ -86,7 +87,7 @@ def memory_need(methods: Sequence[str], rkpm: dict[str, Sequence], fem: dict[str
     if name is None:
         return _preflight.need(0.0, 0, "", "")
     return _preflight.need(_preflight.DAMAGE_BYTES_PER_NODE, sizes[name],
-                           f"{name}={','.join(map(str, lists[name]))}", f"{verb} {name}")
+                           f"{name}={','.join(f'{v:.6g}' for v in lists[name])}", f"{verb} {name}")
 
 
 def plate(xs: np.ndarray, ys: np.ndarray, slits: Sequence, tips: Sequence[tuple[bool, bool]],
@@ -118,20 +119,28 @@ def damage_model(pl: Plate, material: dm.DamageMaterial, regularized: bool = Tru
 def simulate(label: str, pl: Plate, model: dm.DamageModel, track: Tracking | None, constraints: Sequence[Constraint],
              t_end: float, external_force: Callable[[float], np.ndarray] | None = None, samples: int = 200,
              checkpoint_every: int = 0, work_dir: Path | None = None, resume: Path | None = None,
-             comm=None) -> DamageRun:
+             comm=None, vtk: Path | None = None) -> DamageRun:
     """The damage particle method on the plate to ``t_end`` (``rkfx.models.damage_dynamics.run_damage``;
-    with an MPI ``comm`` of several ranks, distributed over them)."""
-    return run_damage(label, pl.op, pl.mass, pl.dt, model, track, constraints, t_end, external_force, samples,
-                      checkpoint_every, work_dir, resume, comm, x=pl.p.x)
+    with an MPI ``comm`` of several ranks, distributed over them); with ``vtk`` a folder, the
+    fields through time are written there for ParaView (``_paraview.damage_frames``)."""
+    frames = _paraview.damage_frames(vtk, label, pl.p.x, _paraview.nodal_cells(pl.domains), comm)
+    bar = step_progress(label, int(np.ceil(t_end / pl.dt - 1e-9)))
+    try:
+        return run_damage(label, pl.op, pl.mass, pl.dt, model, track, constraints, t_end, external_force, samples,
+                          checkpoint_every, work_dir, resume, comm, x=pl.p.x, frames=frames, progress=bar)
+    finally:
+        bar.close()
 
 
-def run_studies(results, studies: Sequence[tuple[str, Sequence, Callable]], summary: Callable) -> None:
+def run_studies(results, studies: Sequence[tuple[str, Sequence, Callable]], summary: Callable,
+                level: str = "n") -> None:
     """Append to ``results`` the runs ``one(level)`` of each ``(study, levels, one)`` and, after
-    each study's runs, ``summary(study, runs)``."""
-    from rkfx.cases._cli import progress  # noqa: PLC0415
-
+    each study's runs, ``summary(study, runs)``; ``level`` names the levels on the terminal."""
     for study, levels, one in studies:
-        runs = [one(v) for v in progress(levels, study)]
+        runs = []
+        for v in levels:
+            with model_run(f"{study} {level}={v:g}"):
+                runs.append(one(v))
         results.runs += runs
         if runs:
             results.runs.append(summary(study, runs))

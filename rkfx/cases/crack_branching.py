@@ -55,7 +55,12 @@ with other parameters is refused in one line (``--recompute`` computes the runs 
 ``mpiexec`` the RKPM models are distributed over the ranks (``rkfx.models.damage_ranks``: the
 serial damage bit for bit); the crack-band FEM models run on rank 0.
 
-    python -m rkfx.cases.crack_branching [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
+    python -m rkfx.cases.crack_branching [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR] [--vtk]
+
+With ``--vtk`` every model writes 21 frames (20 evenly spaced and the end) to OUT/vtk/: damage,
+crack opening w / w_c, displacement and velocity at the particles and on their cells
+(``<run>_particles.pvd``, ``<run>_cells.pvd``), and per element and vertex of the crack-band
+meshes (``fem-crack-band_<size>.pvd``); about 0.5 MB per frame per 3,600 particles.
 """
 import sys
 from collections import Counter
@@ -71,7 +76,7 @@ from rkfx.fracture.tracking import check_tracking, tracking
 from rkfx.assembly.smeared_strain import check_eps_p
 from rkfx.errors import InputError
 from rkfx.models.damage_dynamics import DamageRun
-from rkfx.cases import _cli, _preflight
+from rkfx.cases import _cli, _paraview, _preflight
 from rkfx.cases import _dynamic_fracture as dyn
 from rkfx.cases._cli import Param, Results, Run
 
@@ -225,9 +230,12 @@ def _fem(h: float, prm: dict, io: dict) -> Run:
 
     from fem_baselines.crack_band_dynamics import branching_crack_band  # noqa: PLC0415
 
+    io = dict(io)
+    label = f"fem-crack-band h={h:g}"
     res = branching_crack_band(h, prm["t_end"], E=prm["E"], nu=prm["nu"], rho=prm["rho"], ft=prm["ft"], GF=prm["GF"],
                                sigma=prm["sigma"], plane=prm["plane"], width=LX, height=LY, a1=A1, a2=A2,
-                               courant=prm["courant"], label=f"fem-crack-band h={h:g}", **io)
+                               courant=prm["courant"], label=label,
+                               frames=_paraview.crack_band_frames(io.pop("vtk"), label), **io)
     r = res.run
     columns = np.arange(A1 + 0.5 * h, LX, h)
     counts = dyn.count_branches(res.centroids, r.opening, columns, h, 3.0 * h)
@@ -256,22 +264,24 @@ def _summary(study: str, runs: Sequence[Run]) -> Run:
                                                         "dissipated": r.series["dissipated"]} for r in runs}},
                errors={"dissipation_change_fine": change,
                        "dissipation_spread": float(max(diss) / min(diss) - 1) if min(diss) > 0 else float("inf")},
-               info={"study": "summary", "of": study})
+               info={"study": "summary", "of": study,
+                     "over": "h=" + ",".join(key(r) for r in runs) + " (wall: their sum)"})
 
 
 def run(*, methods: Sequence[str] = ("rkpm",), E=3.2e10, nu=0.2, rho=2450.0, ft=2.72e6, GF=3.0, sigma=1.0e6,
         plane="strain", t_end=80e-6, tol=0.5, h=(8e-4, 4e-4, 2e-4), unregularized_h=(8e-4, 4e-4, 2e-4),
         fem_h=(8e-4, 4e-4, 2e-4), support_factor=1.75, courant=0.5, radius=3.5, forward=True, eps_p=1.0,
-        checkpoint_every=0, work_dir=None, resume=None) -> Results:
+        checkpoint_every=0, work_dir=None, resume=None, vtk=None) -> Results:
     """The damage particle method, regularized and with a constant kappa_c, at each spacing,
-    and the crack-band finite elements at each element size."""
+    and the crack-band finite elements at each element size; ``vtk``: a folder for every run's
+    fields through time (``--vtk``)."""
     hs, unreg, fems = [float(v) for v in h], [float(v) for v in unregularized_h], [float(v) for v in fem_h]
     material = _check(E, nu, rho, ft, GF, sigma, plane, t_end, tol, hs + unreg + fems, support_factor, courant,
                       radius, eps_p)
     prm = dict(E=E, nu=nu, rho=rho, ft=ft, GF=GF, sigma=sigma, plane=plane, t_end=t_end, tol=tol, h=hs,
                unregularized_h=unreg, fem_h=fems, support_factor=support_factor, courant=courant, radius=radius,
                forward=forward, eps_p=eps_p)
-    io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume, "comm": _cli.comm()}
+    io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume, "comm": _cli.comm(), "vtk": vtk}
     xs, ys = grid(max(hs + unreg) if hs + unreg else 8e-4)
     h0 = float(max(np.diff(xs).max(), np.diff(ys).max()))
     kappa_c = GF / (ft * h0)
@@ -284,7 +294,7 @@ def run(*, methods: Sequence[str] = ("rkpm",), E=3.2e10, nu=0.2, rho=2450.0, ft=
                                                                        {"regularized": False, "kappa_c": kappa_c}))]
     if "fem" in methods:
         studies.append(("fem-crack-band", fems, lambda v: _fem(v, prm, io)))
-    dyn.run_studies(results, studies, _summary)
+    dyn.run_studies(results, studies, _summary, level="h")
     return results
 
 

@@ -89,7 +89,11 @@ finished paths are read back from their last checkpoint, the interrupted one con
 own, with the same results as an uninterrupted run.
 
     python -m rkfx.cases.cracked_bar [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
-                                     [--checkpoint-every N] [--resume DIR]
+                                     [--checkpoint-every N] [--resume DIR] [--vtk]
+
+With ``--vtk`` every SCNI and FEM load path writes stress (Voigt, [stress]) and damage at 11 of
+its steps to OUT/vtk/ (SCNI: at the particles and on their cells; FEM: per element); ParaView's
+time is the tip displacement u_T [length] there.
 """
 import sys
 import time
@@ -116,7 +120,7 @@ from rkfx.models.damage_bar import (
 from rkfx.errors import InputError, SolverError
 from rkfx.solvers.newton import NewtonOptions
 from rkfx.solvers.quasi_static import QuasiStatic, march
-from rkfx.cases import _cli, _preflight
+from rkfx.cases import _cli, _paraview, _preflight
 from rkfx.cases._cli import Param, Results, Run
 
 NAME = "cracked_bar"
@@ -295,11 +299,16 @@ def _reference(u, prm) -> dict:
     return {"F_czm": bar.force(u), "w_czm": bar.opening(u)}
 
 
-def _run_scni(label, s, model, targets, prm, info, stress_u=None, io=None) -> Run:
-    """One SCNI load path with its curves, profile at u_T = w_c and (optionally) stresses."""
+def _run_scni(label, s, model, targets, prm, info, stress_u=None, io=None, vtk=None) -> Run:
+    """One SCNI load path with its curves, profile at u_T = w_c and (optionally) stresses; with
+    ``vtk`` a folder, stress and damage at 11 steps of the path are written there."""
     wc = 2 * prm["GF"] / prm["ft"]
     snapshots = [wc] + ([stress_u] if stress_u is not None else [])
-    path = load_path(s, model, targets, snapshots, **(io.for_run(label) if io is not None else {}))
+    frames = _paraview.path_frames(targets) if vtk is not None else []
+    path = load_path(s, model, targets, snapshots + frames, **(io.for_run(label) if io is not None else {}))
+    if vtk is not None:
+        series = _paraview.FieldSeries(vtk, label, s.points, cells=s.geometry, comm=_cli.comm())
+        _paraview.write_path(lambda u, sig, d: series.write(u, stress=sig, damage=d), path.snapshots, frames)
     if model.regularized:
         dm.check_regularization(model, path.state)
     errors = _curve_errors(path.u, path.force, path.dissipated, path.elastic, prm)
@@ -342,8 +351,9 @@ def _run_gauss(n, prm, stress_u, targets, io=None) -> Run:
 
 def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=2.0e6, GF=1.885, ft=200.0, L=100.0, A=10.0,
         nodes=(16, 32, 64, 128), weak_factor=0.999, steps=100, u_end=1.02, stress_at=0.2, support_factor=1.5,
-        cells=CELLS, checkpoint_every=0, work_dir=None, resume=None) -> Results:
+        cells=CELLS, checkpoint_every=0, work_dir=None, resume=None, vtk=None) -> Results:
     """Regularized and unregularized SCNI models, the Gauss vs SCNI stresses, and crack-band FEM.
+    ``vtk``: a folder for the ParaView files of the SCNI and FEM load paths (``--vtk``).
 
     ``checkpoint_every`` accepted steps each load path writes a checkpoint into its folder of
     ``work_dir`` (and one when it ends); ``resume`` (the work directory of an interrupted run)
@@ -385,11 +395,13 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=2.0e6, GF=1.885, ft=200.0
                 end = u_end if cell_kind == "voronoi" else max(u_end, MEDIAN_DUAL_END)
                 targets = _targets(u_peak, wc, steps, end, weak_factor)
                 stress_u = u_peak + stress_at * (wc - u_peak) if regularized else None
-                add(key, n, _run_scni(f"{key} n={n}", s, model, targets, prm,
-                                      {"study": "regularized" if regularized else "unregularized", "nodes": n,
-                                       "cells": cell_kind}, stress_u, io))
+                with _cli.model_run(f"{key} n={n}"):
+                    add(key, n, _run_scni(f"{key} n={n}", s, model, targets, prm,
+                                          {"study": "regularized" if regularized else "unregularized", "nodes": n,
+                                           "cells": cell_kind}, stress_u, io, vtk))
                 if regularized and cell_kind == "voronoi":
-                    results.runs.append(_run_gauss(n, prm, stress_u, targets, io))
+                    with _cli.model_run(f"rkpm-gauss n={n}"):
+                        results.runs.append(_run_gauss(n, prm, stress_u, targets, io))
     if "fem" in methods:
         import dolfinx_solver  # noqa: F401, PLC0415
 
@@ -397,8 +409,16 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=2.0e6, GF=1.885, ft=200.0
 
         for n in _cli.progress(nodes, "fem-crack-band"):
             u_peak = weak_factor * ft * L / E
-            res = solve_crack_band(L, A, E, GF, ft, n - 1, _targets(u_peak, wc, steps, u_end, weak_factor),
-                                   weak_factor=weak_factor, u_profile=wc, **io.for_run(f"fem-crack-band n={n}"))
+            targets = _targets(u_peak, wc, steps, u_end, weak_factor)
+            frames = _paraview.path_frames(targets) if vtk is not None else []
+            with _cli.model_run(f"fem-crack-band n={n}"):
+                res = solve_crack_band(L, A, E, GF, ft, n - 1, targets, weak_factor=weak_factor, u_profile=wc,
+                                       snapshots=frames, **io.for_run(f"fem-crack-band n={n}"))
+            if vtk is not None:
+                mesh = _paraview.MeshSeries(vtk, f"fem-crack-band n={n}", res.vertices, res.cells)
+                _paraview.write_path(lambda u, sig, d: mesh.write(u, cell_data={"stress": sig[res.cell_dofs],
+                                                                                  "damage": d[res.cell_dofs]}),
+                                     res.snapshots, frames)
             errors = _curve_errors(res.u, res.force, res.dissipated, res.elastic, prm)
             col_of = np.round(res.x / res.h - 0.5).astype(int)  # triangle centroids at 1/3 and 2/3 of a column
             column = np.arange(col_of.max() + 1)
@@ -417,7 +437,9 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=2.0e6, GF=1.885, ft=200.0
                                 max(r.n_dofs for r in by_n.values()),
                                 series={"u_T_max": {k: r.errors["u_T_max"] for k, r in by_n.items()},
                                         "dissipated": {k: r.errors["dissipated"] for k, r in by_n.items()}},
-                                info={"study": "summary"}))
+                                info={"study": "summary", "of": key,
+                                      "over": "nodes=" + ",".join(by_n) + " (u_T_max, dissipated per n in "
+                                              "results.json; wall: their sum)"}))
     return results
 
 

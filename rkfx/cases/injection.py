@@ -44,7 +44,11 @@ Parameters (``--set NAME=VALUE``, SI units): E, nu, rho_s, rho_w, porosity, k_h,
 K_s, GF, ft, viscosity, alpha, L, c, rate, t_end, dt, t_out, h, tol, radius, jacobian,
 support_factor. Long runs: ``--checkpoint-every N`` and ``--resume DIR``.
 
-    python -m rkfx.cases.injection [--quick] [--method rkpm|both] [--set NAME=VALUE] [--out DIR]
+    python -m rkfx.cases.injection [--quick] [--method rkpm|both] [--set NAME=VALUE] [--out DIR] [--vtk]
+
+With ``--vtk`` every refinement writes, at the times ``t_out``, displacement [m], pressure [Pa],
+damage, crack opening w / w_c, smeared strain and the permeability k_f (5.8) [m^2/(Pa s)] at the
+particles and on their cells to OUT/vtk/rkpm_h<h>_particles.pvd / _cells.pvd.
 """
 import math
 import sys
@@ -67,6 +71,7 @@ from rkfx.models.hydraulic_fracture import JACOBIANS, FracturingRock, HydraulicF
 from rkfx.solvers.integrate import integrate
 from rkfx.solvers.newmark import trapezoidal
 from rkfx.solvers.newton import NewtonOptions
+from rkfx.output.paraview import FieldSeries, nodal_cells
 
 NAME = "injection"
 SIDES = ("left", "right", "bottom", "top")
@@ -163,8 +168,10 @@ class _Record:
     """Per committed step: crack tips, cracked count; at the map times: p on the sample grid,
     damage at the map particles."""
 
-    def __init__(self, model: HydraulicFractureModel, h: float, notch: np.ndarray, t_out, samples, shown):
+    def __init__(self, model: HydraulicFractureModel, h: float, notch: np.ndarray, t_out, samples, shown,
+                 vtk: FieldSeries | None = None):
         self.model, self.h, self.notch, self.t_out = model, h, notch, np.asarray(t_out, float)
+        self.vtk = vtk
         self.sample_rows = evaluate(model.rk, samples).matrix()
         self.shown = shown
         self.rows = {k: [] for k in ("t", "left", "right", "cracked", "iterations", "notch_p")}
@@ -194,6 +201,16 @@ class _Record:
             self.maps["p"].append(self.sample_rows @ P)
             self.maps["damage"].append(m.committed.damage[self.shown])
             self.maps["opening"].append(self.opening()[self.shown])
+            if self.vtk is not None:
+                self.write_fields(s)
+
+    def write_fields(self, s) -> None:
+        """The particle fields at the committed step ``s`` for ParaView."""
+        m = self.model
+        k = m.permeability(m.committed, m.strain)
+        self.vtk.write(s.t, displacement=m.displacements(s.x), pressure=m.pressures(s.x),
+                       damage=m.committed.damage, crack_opening=self.opening(), strain=m.strain * [1.0, 1.0, 0.5],
+                       permeability=np.column_stack([k[:, 0, 0], k[:, 1, 1], k[:, 0, 1]]))
 
     def sample_centre(self, s) -> float:
         """p^h at the notch's centre particle [Pa]."""
@@ -210,8 +227,9 @@ class _Record:
 
 
 def solve(h: float, *, L, c, rate, t_end, dt, t_out, tol, radius, jacobian, support_factor, rock, max_cuts=12,
-          io=None, comm=None) -> dict:
-    """One refinement: the crack history, maps and Darcy velocity (see the module docstring)."""
+          io=None, comm=None, vtk=None) -> dict:
+    """One refinement: the crack history, maps and Darcy velocity (see the module docstring); with
+    ``vtk`` a folder, the particle fields at the times ``t_out`` are written there."""
     t0 = time.perf_counter()
     N = _intervals(L, h)
     xs = -L / 2 + h * np.arange(N + 1)
@@ -235,7 +253,8 @@ def solve(h: float, *, L, c, rate, t_end, dt, t_out, tol, radius, jacobian, supp
     step = max(1, int(math.ceil((N + 1) / MAP_MAX)))
     keep = np.arange(0, N + 1, step)
     shown = (keep[:, None] * (N + 1) + keep[None, :]).ravel()  # row j (y), column i (x): j (N+1) + i
-    rec = _Record(model, h, notch, t_out, samples, shown)
+    series = None if vtk is None else FieldSeries(vtk, f"rkpm h={h:g}", p.x, cells=nodal_cells(domains), comm=comm)
+    rec = _Record(model, h, notch, t_out, samples, shown, series)
     times = np.unique(np.r_[np.arange(0.0, t_end, dt), t_end, np.asarray(t_out, float)])
     io = io or {}
     # Backtracking: near the damage threshold the loading set of the tangent can flip between
@@ -269,8 +288,9 @@ def solve(h: float, *, L, c, rate, t_end, dt, t_out, tol, radius, jacobian, supp
 def run(*, methods: Sequence[str] = ("rkpm",), E=2.1e11, nu=0.3, rho_s=3000.0, rho_w=1000.0, porosity=0.2,
         k_h=1e-8, gamma_w=1e4, K_w=2e9, K_s=1e11, GF=2.7e3, ft=2.1e7, viscosity=1e-3, alpha=1.0, L=1.0, c=0.1,
         rate=5.5e4, t_end=4000.0, dt=50.0, t_out=(1000.0, 2000.0, 3000.0, 4000.0), h=(5e-3, 2.5e-3), tol=0.3,
-        radius=3.5, jacobian="full", support_factor=1.5, max_cuts=12, checkpoint_every=0, work_dir=None, resume=None) -> Results:
-    """Every refinement; see the module docstring."""
+        radius=3.5, jacobian="full", support_factor=1.5, max_cuts=12, checkpoint_every=0, work_dir=None, resume=None,
+        vtk=None) -> Results:
+    """Every refinement; see the module docstring. ``vtk``: a folder for the ParaView files (``--vtk``)."""
     material = dict(E=E, nu=nu, rho_s=rho_s, rho_w=rho_w, porosity=porosity, k_h=k_h, gamma_w=gamma_w, K_w=K_w,
                     K_s=K_s, GF=GF, ft=ft, viscosity=viscosity, alpha=alpha)
     setup = dict(L=L, c=c, rate=rate, t_end=t_end, dt=dt, t_out=list(t_out), tol=tol, radius=radius,
@@ -285,7 +305,8 @@ def run(*, methods: Sequence[str] = ("rkpm",), E=2.1e11, nu=0.3, rho_s=3000.0, r
     runs = []
     for hh in sorted(h, reverse=True):
         label = f"rkpm h={hh:g}"
-        s = solve(hh, **setup, rock=rock, io=ck.for_run(f"rkpm-h{hh:g}"), comm=_cli.comm())
+        with _cli.model_run(label):
+            s = solve(hh, **setup, rock=rock, io=ck.for_run(f"rkpm-h{hh:g}"), comm=_cli.comm(), vtk=vtk)
         rows = {k: np.array(v, float) for k, v in s["rec"].rows.items()}
         outside = np.flatnonzero(rows["cracked"] > 0)
         onset = float(rows["t"][outside[0]]) if outside.size else None

@@ -26,15 +26,18 @@ dt = 0.5 h / c_d (``rkfx.assembly.smeared_strain``); the impact
 velocity and the roller are collocation conditions imposed by projection. Each run goes to
 ``t_end`` = 80 microseconds.
 
-Studies (``nodes`` gives the particles per side; the run uses the nearest admissible nx, ny):
+Studies at the particle spacings ``h`` [m], as in the branching case: a model of spacing h has
+n = round(0.1 / h) + 1 particle columns (n x n', n' = n + 0..3 rows, so that the crack lies on
+cell faces: ``grid``); runs are labelled by n (``rkpm-dpm n=150`` is h = 0.1 / 149 m). The older
+names ``nodes``, ``unregularized_nodes``, ``no_tracking_nodes``, ``fem_nodes`` (counts n) still
+work with ``--set`` and are converted to h.
 
-* ``rkpm-dpm``: the damage particle method at every refinement (Fig 4.13-4.15b);
+* ``rkpm-dpm``: the damage particle method at every refinement ``h`` (Fig 4.13-4.15b);
 * ``rkpm-dpm-unregularized``: a constant kappa_c, the regularized value of the coarsest model's
-  square cells (G_F / (f_t h_0)), at ``unregularized_nodes`` (Fig 4.15a);
-* ``rkpm-dpm-no-tracking``: tracking off at ``no_tracking_nodes`` (Fig 4.16);
+  square cells (G_F / (f_t h_0)), at ``unregularized_h`` (Fig 4.15a);
+* ``rkpm-dpm-no-tracking``: tracking off at ``no_tracking_h`` (Fig 4.16);
 * ``fem-crack-band``: linear triangles with a crack band and the same damage law, lumped mass
-  and central differences (``fem_baselines.crack_band_dynamics``), at ``fem_nodes`` (element
-  size 0.1 / (n - 1)).
+  and central differences (``fem_baselines.crack_band_dynamics``), of element size ``fem_h``.
 
 Metrics per run: the crack angle [deg] from the +x axis (the major axis of the cracked
 particles, crack opening w / w_c >= 0.5 (``_dynamic_fracture``), within ``angle_radius`` of
@@ -45,8 +48,8 @@ cracked particles (``dissipated_in_cracks``), and the number of cracked particle
 crack plane (y < a2 - 3 h), where the physical crack never goes (spurious damage). A summary
 run per study maps node counts to angles and final dissipation and gives their spread.
 
-Parameters (``--set NAME=VALUE``, SI units): E, nu, rho, ft, GF, v0, t_end, tol, nodes,
-unregularized_nodes, no_tracking_nodes, fem_nodes, support_factor, courant, radius, forward, eps_p,
+Parameters (``--set NAME=VALUE``, SI units): E, nu, rho, ft, GF, v0, t_end, tol, h,
+unregularized_h, no_tracking_h, fem_h, support_factor, courant, radius, forward, eps_p,
 angle_radius. Long runs: ``--checkpoint-every N`` writes each model's state every N steps to
 OUT/checkpoints/, and ``--resume DIR`` continues an interrupted invocation (finished models are
 read back). A resume with other parameters is refused in one line (``--recompute`` computes the
@@ -54,7 +57,12 @@ runs again). Under ``mpiexec`` the RKPM models are distributed over the ranks
 (``rkfx.models.damage_ranks``: the serial damage bit for bit); the crack-band FEM models run on
 rank 0.
 
-    python -m rkfx.cases.kalthoff [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
+    python -m rkfx.cases.kalthoff [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR] [--vtk]
+
+With ``--vtk`` every model writes 21 frames (20 evenly spaced and the end) to OUT/vtk/: damage,
+crack opening w / w_c, displacement and velocity at the particles and on their cells
+(``<run>_particles.pvd``, ``<run>_cells.pvd``), and per element and vertex of the crack-band
+meshes (``fem-crack-band_<size>.pvd``); about 0.5 MB per frame per 3,600 particles.
 """
 import sys
 from collections.abc import Sequence
@@ -68,13 +76,22 @@ from rkfx.fracture.tracking import check_tracking, tracking
 from rkfx.errors import InputError
 from rkfx.assembly.smeared_strain import check_eps_p, constraint
 from rkfx.models.damage_dynamics import DamageRun
-from rkfx.cases import _cli, _preflight
+from rkfx.cases import _cli, _paraview, _preflight
 from rkfx.cases import _dynamic_fracture as dyn
 from rkfx.cases._cli import Param, Results, Run
 
 NAME = "kalthoff"
 SIDE, A1, A2 = 0.1, 0.05, 0.025
 EXPERIMENT_ANGLE = 70.0
+
+def spacings(nodes: Sequence[int]) -> list[float]:
+    """The spacings h = 0.1 / (n - 1) [m] of models with n particle columns."""
+    return [SIDE / (int(n) - 1) for n in nodes]
+
+
+def _nodes_alias(name: str) -> _cli.Alias:
+    return _cli.Alias(name, [150], spacings, "particle columns n, h = 0.1 m / (n - 1)")
+
 
 PARAMS = {
     "E": Param(1.9e11, "Young's modulus [Pa]"),
@@ -85,10 +102,14 @@ PARAMS = {
     "v0": Param(16.5, "impact velocity [m/s]"),
     "t_end": Param(80e-6, "end time [s]"),
     "tol": Param(0.3, "particle tracking tolerance of (4.22) [-], in (0, 1]"),
-    "nodes": Param([150, 250, 350, 450], "particles per side of the regularized models [count] (nx x ny: see grid)"),
-    "unregularized_nodes": Param([150, 250, 350], "particles per side of the constant-kappa_c models [count]"),
-    "no_tracking_nodes": Param([150, 250], "particles per side of the models without tracking [count]", fingerprint=False),
-    "fem_nodes": Param([150, 250], "crack-band FEM: n [count], element size 0.1 m / (n - 1)", fingerprint=False),
+    "h": Param(spacings([150, 250, 350, 450]), "particle spacings of the regularized models [m]",
+               aliases=(_nodes_alias("nodes"),)),
+    "unregularized_h": Param(spacings([150, 250, 350]), "particle spacings of the constant-kappa_c models [m]",
+                             aliases=(_nodes_alias("unregularized_nodes"),)),
+    "no_tracking_h": Param(spacings([150, 250]), "particle spacings of the models without tracking [m]",
+                           fingerprint=False, aliases=(_nodes_alias("no_tracking_nodes"),)),
+    "fem_h": Param(spacings([150, 250]), "crack-band FEM element sizes [m]", fingerprint=False,
+                   aliases=(_nodes_alias("fem_nodes"),)),
     "support_factor": Param(1.75, "RK support radius / nodal spacing [-] (>= 1.6: see the module docstring)"),
     "courant": Param(0.5, "dt = courant * h / c_d [-], in (0, 1]"),
     "radius": Param(3.5, "tracking neighbourhood radius / nodal spacing [-], >= 1"),
@@ -97,7 +118,13 @@ PARAMS = {
     "angle_radius": Param(0.1, "crack-angle fit: cracked particles within this distance of the tip [m]",
                           fingerprint=False),
 }
-QUICK = {"nodes": [60, 90, 120], "unregularized_nodes": [60, 120], "no_tracking_nodes": [90], "fem_nodes": [60]}
+QUICK = {"h": spacings([60, 90, 120]), "unregularized_h": spacings([60, 120]), "no_tracking_h": spacings([90]),
+         "fem_h": spacings([60])}
+
+
+def columns(h: Sequence[float]) -> list[int]:
+    """Particle columns n = round(0.1 / h) + 1 of the spacings ``h`` [m]."""
+    return [int(round(SIDE / float(v))) + 1 for v in h]
 
 
 def grid(n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -121,27 +148,27 @@ def _check(E, nu, rho, ft, GF, v0, t_end, tol, nodes, support_factor, courant, r
     check_eps_p(eps_p)
     for n in nodes:
         if n < 20:
-            raise InputError(f"nodes = {n}: use at least 20 particles per side (the crack needs cells around it)")
+            raise InputError(f"h = {SIDE / (n - 1):.4g} m: use h <= {SIDE / 19:.4g} m, at least 20 particles per "
+                             "side (the crack needs cells around it)")
     material = dm.DamageMaterial(E, nu, ft, GF, "strain")
     h = SIDE / (min(nodes) - 1)
     if not material.critical_opening / 2 / h > material.kappa0:
-        raise InputError(f"nodes = {min(nodes)} is too coarse for G_F: kappa_c = G_F / (f_t h) <= kappa0; use "
+        raise InputError(f"h = {h:.4g} m is too coarse for G_F: kappa_c = G_F / (f_t h) <= kappa0; use "
                          f"h < E G_F / f_t^2 = {E * GF / ft**2:.3g} m")
     return material
 
 
-def check(*, E, nu, rho, ft, GF, v0, t_end, tol, nodes, unregularized_nodes, no_tracking_nodes, fem_nodes,
+def check(*, E, nu, rho, ft, GF, v0, t_end, tol, h, unregularized_h, no_tracking_h, fem_h,
           support_factor, courant, radius, angle_radius, eps_p, **_) -> None:
     """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
-    every = [int(n) for n in [*nodes, *unregularized_nodes, *no_tracking_nodes, *fem_nodes]]
+    every = columns([*h, *unregularized_h, *no_tracking_h, *fem_h])
     _check(E, nu, rho, ft, GF, v0, t_end, tol, every, support_factor, courant, radius, angle_radius, eps_p)
 
 
-def memory_need(methods, *, nodes, unregularized_nodes, no_tracking_nodes, fem_nodes, **_) -> _preflight.Need:
+def memory_need(methods, *, h, unregularized_h, no_tracking_h, fem_h, **_) -> _preflight.Need:
     """Peak memory of the largest model, about n^2 particles (see ``rkfx.cases._preflight``)."""
-    return dyn.memory_need(methods, {"nodes": nodes, "unregularized_nodes": unregularized_nodes,
-                                     "no_tracking_nodes": no_tracking_nodes}, {"fem_nodes": fem_nodes},
-                           lambda n: (n + 1) ** 2)
+    return dyn.memory_need(methods, {"h": h, "unregularized_h": unregularized_h, "no_tracking_h": no_tracking_h},
+                           {"fem_h": fem_h}, lambda v: (columns([v])[0] + 1) ** 2, verb="raise")
 
 
 def model_conditions(pl: dyn.Plate, v0: float):
@@ -188,8 +215,11 @@ def _fem(n, prm, io) -> Run:
     from fem_baselines.crack_band_dynamics import kalthoff_crack_band  # noqa: PLC0415
 
     h = SIDE / (n - 1)
+    io = dict(io)
+    label = f"fem-crack-band n={n}"
     res = kalthoff_crack_band(h, prm["t_end"], E=prm["E"], nu=prm["nu"], rho=prm["rho"], ft=prm["ft"], GF=prm["GF"],
-                              v0=prm["v0"], courant=prm["courant"], label=f"fem-crack-band n={n}", **io)
+                              v0=prm["v0"], courant=prm["courant"], label=label,
+                              frames=_paraview.crack_band_frames(io.pop("vtk"), label), **io)
     r = res.run
     angle = dyn.crack_angle(res.centroids, r.opening, np.array([A1, A2]), prm["angle_radius"])
     below = int(np.sum((r.opening >= dyn.CRACKED) & (res.centroids[:, 1] < A2 - 3 * h)))
@@ -214,23 +244,25 @@ def _summary(study: str, runs: Sequence[Run]) -> Run:
                                                for r in runs}},
                errors={"angle_min": min(found, default=float("nan")), "angle_max": max(found, default=float("nan")),
                        "dissipation_spread": float(max(diss) / min(diss) - 1) if min(diss) > 0 else float("inf")},
-               info={"study": "summary", "of": study})
+               info={"study": "summary", "of": study,
+                     "over": "nodes=" + ",".join(str(r.info["nodes"]) for r in runs) + " (wall: their sum)"})
 
 
 def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.9e11, nu=0.3, rho=8000.0, ft=9.5e8, GF=2.0e4, v0=16.5,
-        t_end=80e-6, tol=0.3, nodes=(150, 250, 350, 450), unregularized_nodes=(150, 250, 350),
-        no_tracking_nodes=(150, 250), fem_nodes=(150, 250), support_factor=1.75, courant=0.5, radius=3.5, forward=True,
-        eps_p=1.0, angle_radius=0.1, checkpoint_every=0, work_dir=None, resume=None) -> Results:
-    """The damage particle method with and without regularization and tracking, and the crack-band FEM."""
-    nodes, unreg, free, fem = ([int(n) for n in v] for v in (nodes, unregularized_nodes, no_tracking_nodes,
-                                                              fem_nodes))
+        t_end=80e-6, tol=0.3, h=spacings([150, 250, 350, 450]), unregularized_h=spacings([150, 250, 350]),
+        no_tracking_h=spacings([150, 250]), fem_h=spacings([150, 250]), support_factor=1.75, courant=0.5, radius=3.5,
+        forward=True, eps_p=1.0, angle_radius=0.1, checkpoint_every=0, work_dir=None, resume=None, vtk=None) -> Results:
+    """The damage particle method with and without regularization and tracking, and the crack-band FEM,
+    at the spacings ``h`` ... ``fem_h`` [m] (``columns``); ``vtk``: a folder for every run's fields
+    through time (``--vtk``)."""
+    nodes, unreg, free, fem = (columns(v) for v in (h, unregularized_h, no_tracking_h, fem_h))
     material = _check(E, nu, rho, ft, GF, v0, t_end, tol, nodes + unreg + free + fem, support_factor, courant,
                       radius, angle_radius, eps_p)
-    prm = {"E": E, "nu": nu, "rho": rho, "ft": ft, "GF": GF, "v0": v0, "t_end": t_end, "tol": tol, "nodes": nodes,
-           "unregularized_nodes": unreg, "no_tracking_nodes": free, "fem_nodes": fem,
+    prm = {"E": E, "nu": nu, "rho": rho, "ft": ft, "GF": GF, "v0": v0, "t_end": t_end, "tol": tol, "h": list(h),
+           "unregularized_h": list(unregularized_h), "no_tracking_h": list(no_tracking_h), "fem_h": list(fem_h),
            "support_factor": support_factor, "courant": courant, "radius": radius, "forward": forward, "eps_p": eps_p,
            "angle_radius": angle_radius}
-    io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume, "comm": _cli.comm()}
+    io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume, "comm": _cli.comm(), "vtk": vtk}
     coarse = min(nodes + unreg) if nodes + unreg else 150
     kappa_c = GF / (ft * (SIDE / (grid(coarse)[0].size - 1)))
     results = Results(NAME, {**prm, "kappa0": material.kappa0, "kappa_c_unregularized": kappa_c})

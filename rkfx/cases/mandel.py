@@ -36,7 +36,10 @@ S [1/Pa], Lx [m], Ly [m], F [N/m], nx, ny, dt_D [-], growth [-], t_D (list), var
 early_variants (list), fem (list), support_factor [-].
 
     python -m rkfx.cases.mandel [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
-        [--checkpoint-every N] [--resume DIR]
+        [--checkpoint-every N] [--resume DIR] [--vtk]
+
+With ``--vtk`` the runs of the profiles study write displacement, pressure, strain and effective
+stress at the times ``t_D`` to OUT/vtk/ (RKPM: particles and nodal cells; FEM: dolfinx VTK files).
 
 With ``--checkpoint-every N`` every run (RKPM and FEM) writes its state every N steps (and at its end) to
 OUT/checkpoints/; ``--resume DIR`` continues a killed invocation from DIR/checkpoints/, finished
@@ -55,7 +58,7 @@ from rkfx.errors import InputError
 from rkfx.geometry.particles import structured
 from rkfx.models.poroelasticity import VARIANTS, PoroMaterial, solve_biot
 from rkfx.solvers.integrate import time_grid
-from rkfx.cases import _cli, _preflight
+from rkfx.cases import _cli, _paraview, _preflight
 from rkfx.cases._cli import Param, Results, Run
 
 NAME = "mandel"
@@ -136,30 +139,38 @@ def _conditions(exact):
             Pressure("right")]
 
 
-def _rkpm(p, material, bcs, times, outputs, variant, support_factor, desc, io):
+def _rkpm(p, material, bcs, times, outputs, variant, support_factor, desc, io, vtk=None, vtk_times=None):
+    """One RKPM run; with ``vtk`` a folder, its fields at ``vtk_times`` [s] are written there."""
     kinds = split(bcs)
     sol = solve_biot(p, material, times, outputs, kinds[Displacement], kinds[Pressure], variant=variant,
                      support_factor=support_factor, comm=_cli.comm(),
                      progress=lambda it: _cli.progress(it, desc, len(times) - 1), **io)
+    if vtk is not None:
+        _paraview.write_biot(vtk, f"rkpm-{variant}", p, sol, material.elastic, _cli.comm(), vtk_times)
     return sol, sol.pressure, sol.wall_time_s, sol.n_dofs
 
 
-def _fem(xs, ys, material, bcs, times, outputs, element, samples, io):
+def _fem(xs, ys, material, bcs, times, outputs, element, samples, io, vtk=None, vtk_times=None):
     import dolfinx_solver  # noqa: F401, PLC0415
 
     from fem_baselines import poroelasticity as fb  # noqa: PLC0415
 
     mesh = fb.rectangle_mesh(xs, ys, "triangle" if element == "taylor-hood" else "quadrilateral")
+    series = _paraview.fem_series(vtk, f"fem-{element}", mesh, vtk_times)
     res = fb.solve_biot(mesh, material.E, material.nu, material.k, material.alpha, material.S, element, bcs,
-                        times, samples, outputs, **io)
+                        times, samples, outputs, vtk=series,
+                        progress=lambda it: _cli.progress(it, f"fem-{element}", len(times) - 1), **io)
+    if series is not None:
+        series.close()
     return res.p, res.wall_time_s, res.n_dofs
 
 
 def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, alpha=1.0, S=0.0, Lx=20.0,
         Ly=2.0, F=40.0, nx=101, ny=11, dt_D=0.01, growth=1.6, t_D=(0.01, 0.1, 0.5, 1.0),
         variants=("scni+fpp", "ni"), early_variants=VARIANTS, fem=FEM_ELEMENTS, support_factor=1.5,
-        checkpoint_every=0, work_dir=None, resume=None) -> Results:
-    """Both studies for every requested method; see the module docstring."""
+        checkpoint_every=0, work_dir=None, resume=None, vtk=None) -> Results:
+    """Both studies for every requested method; see the module docstring. ``vtk``: a folder for the
+    ParaView files of the profiles study's runs at the times ``t_D`` (``--vtk``)."""
     _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F, support_factor)
     material = PoroMaterial(E, nu, k, alpha, S)
     exact = Mandel(E, nu, k, Lx, Ly, F, alpha, S)
@@ -183,18 +194,20 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, 
     if "rkpm" in methods:
         for v in dict.fromkeys(list(variants) + list(early_variants)):
             solvers.append((f"rkpm-{v}", v in variants, v in early_variants,
-                            lambda tt, out, key, v=v: _rkpm(particles, material, bcs, tt, out, v, support_factor,
-                                                            f"rkpm {v}", ck.for_run(key))))
+                            lambda tt, out, key, shown=None, v=v: _rkpm(particles, material, bcs, tt, out, v,
+                                                                        support_factor, f"rkpm {v}", ck.for_run(key),
+                                                                        shown, t_out)))
     if "fem" in methods:
         for e in fem:
-            def fem_solve(tt, out, key, e=e):
-                pp, wall, dofs = _fem(xs, ys, material, bcs, tt, out, e, samples, ck.for_run(key))
+            def fem_solve(tt, out, key, shown=None, e=e):
+                pp, wall, dofs = _fem(xs, ys, material, bcs, tt, out, e, samples, ck.for_run(key), shown, t_out)
                 return None, (lambda pts, pp=pp: pp), wall, dofs
             solvers.append((f"fem-{e}", True, True, fem_solve))
     for label, profiles, early, solve in solvers:
         run_ = Run(label, 0.0, 0, series={"x": x}, info={"nodes": nx * ny})
         if profiles:
-            _, sample, wall, dofs = solve(times, times[1:], f"{label}-profiles")
+            with _cli.model_run(f"{label} profiles"):
+                _, sample, wall, dofs = solve(times, times[1:], f"{label}-profiles", vtk)
             p_all = sample(samples)
             keep = np.searchsorted(times[1:], t_out)
             p_h = p_all[keep]
@@ -207,7 +220,8 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, 
         if early:
             for dtd, nsteps in EARLY:
                 tt = dtd * h**2 / c * np.arange(nsteps + 1)
-                _, sample, wall, dofs = solve(tt, tt[-1:], f"{label}-early-dtD{dtd:g}")
+                with _cli.model_run(f"{label} early dt_D={dtd:g}"):
+                    _, sample, wall, dofs = solve(tt, tt[-1:], f"{label}-early-dtD{dtd:g}")
                 ph = sample(samples)[0]
                 pe = exact.pressure(x, tt[-1])
                 tag = f"early_dtD{dtd:g}"

@@ -30,7 +30,10 @@ error on the finest mesh.
 Parameters and units (``--set NAME=VALUE``): E [Pa], nu [-], T [Pa], a [m], L [m], h [m],
 levels, rules (RKPM integration rules), support_factor [-], bc_method, fem_degrees.
 
-    python -m rkfx.cases.plate_with_hole [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
+    python -m rkfx.cases.plate_with_hole [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR] [--vtk]
+
+With ``--vtk`` every run writes its field at t = 0 to OUT/vtk/<run>-level<l>: RKPM displacement,
+strain and stress at the particles and on their median-dual cells, FEM displacement.
 """
 import math
 import sys
@@ -49,7 +52,7 @@ from rkfx.models.elastostatics import solve_plane_strain
 from rkfx.errors import InputError
 from rkfx.integration.norms import relative_errors
 from rkfx.integration.quadrature import RULES
-from rkfx.cases import _cli, _preflight
+from rkfx.cases import _cli, _paraview, _preflight
 from rkfx.cases._cli import Param, Results, Run
 
 NAME = "plate_with_hole"
@@ -167,7 +170,7 @@ def _fem_sigma_xx(result, m: ElasticMaterial, points: np.ndarray) -> np.ndarray:
 def run(*, methods: Sequence[str] = ("rkpm", "fem"), E: float = 1.0e3, nu: float = 0.3, T: float = 1.0,
         a: float = 1.0, L: float = 5.0, h: float = 0.5, levels: int = 4, rules: Sequence[str] = ("mscni",),
         support_factor: float = 1.5, bc_method: str = "transformation", fem_degrees: Sequence[int] = (1, 2),
-        comm=None) -> Results:
+        comm=None, vtk=None) -> Results:
     """Solve the quarter plate on ``levels`` meshes with every requested method.
 
     Args:
@@ -181,6 +184,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E: float = 1.0e3, nu: float
         support_factor, bc_method: RKPM support a_I = c h_I and essential-BC method.
         fem_degrees: FEM Lagrange degrees.
         comm: MPI communicator (default COMM_WORLD).
+        vtk: A folder for the ParaView files of every run (``<label>-level<l>``), or ``None``.
 
     Returns:
         One ``Run`` per method and level, labelled ``rkpm-<rule>`` / ``fem-p<degree>``, with
@@ -230,45 +234,52 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E: float = 1.0e3, nu: float
     bcs = [Displacement("left", 0.0, (0,)), Displacement("bottom", 0.0, (1,)),
            *(Traction(side, lambda x, t, n: exact.traction(x, n)) for side in ("right", "top"))]
     try:
-        for lev in _cli.progress(range(levels), desc=NAME):
+        for lev in range(levels):
             hl = h / 2**lev
             if rank == 0:
                 mesh_plate(a, L, hl)
             p = from_gmsh(gmsh.model, comm)
             u_nodes = exact.displacement(p.x)
             for label in labels:
-                if label.startswith("rkpm"):
-                    t0 = time.perf_counter()
-                    sol = solve_plane_strain(p, material, bcs, rule=label[5:], bc_method=bc_method,
-                                             support_factor=support_factor, comm=comm)
-                    wall, n_dofs = time.perf_counter() - t0, sol.n_dofs
-                    errors = relative_errors(p, sol.rk, sol.coefficients, exact.displacement,
-                                             exact.displacement_gradient)
-                    points = axis
-                    sxx_axis = _stress_xx(sol.gradient(points), material)
-                    u_h = sol.displacement(p.x)
-                else:
-                    res = fem.solve_plane_strain(gmsh.model, E, nu, bcs, degree=int(label[5:]), comm=comm)
-                    wall, n_dofs = res.wall_time_s, res.n_dofs
-                    e = fem.errors(res, lambda X: ufl.as_vector(exact.displacement_xy(X[0], X[1], ufl.sqrt)))
-                    errors = {"l2": e["l2"], "h1": e["h1"]}
-                    # FEM stresses jump across cells: move the profile into the domain by 1 % of
-                    # the hole's mesh size (well beyond dolfinx's ~1e-5 collision tolerance), so one
-                    # cell holds each point whatever the partition; the hole value is then that of
-                    # the corner cell in the direction (1, 1), compared with the exact value there.
-                    delta = 0.01 * hl / HOLE_REFINEMENT
-                    points = axis + [delta, 0.0]
-                    points[0, 1] += delta
-                    sxx_axis = _fem_sigma_xx(res, material, points)
-                    u_h = res.evaluate(p.x)
-                errors["sxx_hole"] = float(sxx_axis[0])
-                errors["sxx_hole_err"] = abs(sxx_axis[0] - exact.stress(points[:1])[0, 0]) / abs(3 * T)
-                series = {"y_axis": y_axis, "sxx_axis": sxx_axis}
-                if lev == levels - 1:
-                    series.update(node_x=p.x[:, 0], node_y=p.x[:, 1],
-                                  node_error=np.linalg.norm(u_h - u_nodes, axis=1) / np.abs(u_nodes).max())
-                results.runs.append(Run(label, float(wall), int(n_dofs), series, errors,
-                                        {"level": lev, "h": hl, "nodes": p.num_nodes}))
+                with _cli.model_run(f"{label} level {lev}"):
+                    if label.startswith("rkpm"):
+                        t0 = time.perf_counter()
+                        sol = solve_plane_strain(p, material, bcs, rule=label[5:], bc_method=bc_method,
+                                                 support_factor=support_factor, comm=comm)
+                        wall, n_dofs = time.perf_counter() - t0, sol.n_dofs
+                        errors = relative_errors(p, sol.rk, sol.coefficients, exact.displacement,
+                                                 exact.displacement_gradient)
+                        points = axis
+                        sxx_axis = _stress_xx(sol.gradient(points), material)
+                        u_h = sol.displacement(p.x)
+                        if vtk is not None:
+                            _paraview.write_elastic(vtk, f"{label}-level{lev}", p, sol, material, comm)
+                    else:
+                        res = fem.solve_plane_strain(gmsh.model, E, nu, bcs, degree=int(label[5:]), comm=comm)
+                        wall, n_dofs = res.wall_time_s, res.n_dofs
+                        e = fem.errors(res, lambda X: ufl.as_vector(exact.displacement_xy(X[0], X[1], ufl.sqrt)))
+                        errors = {"l2": e["l2"], "h1": e["h1"]}
+                        # FEM stresses jump across cells: move the profile into the domain by 1 % of
+                        # the hole's mesh size (well beyond dolfinx's ~1e-5 collision tolerance), so one
+                        # cell holds each point whatever the partition; the hole value is then that of
+                        # the corner cell in the direction (1, 1), compared with the exact value there.
+                        delta = 0.01 * hl / HOLE_REFINEMENT
+                        points = axis + [delta, 0.0]
+                        points[0, 1] += delta
+                        sxx_axis = _fem_sigma_xx(res, material, points)
+                        u_h = res.evaluate(p.x)
+                        series = _paraview.fem_series(vtk, f"{label}-level{lev}", res.mesh)
+                        if series is not None:
+                            with series:
+                                series.write(0.0, displacement=res.u)
+                    errors["sxx_hole"] = float(sxx_axis[0])
+                    errors["sxx_hole_err"] = abs(sxx_axis[0] - exact.stress(points[:1])[0, 0]) / abs(3 * T)
+                    series = {"y_axis": y_axis, "sxx_axis": sxx_axis}
+                    if lev == levels - 1:
+                        series.update(node_x=p.x[:, 0], node_y=p.x[:, 1],
+                                      node_error=np.linalg.norm(u_h - u_nodes, axis=1) / np.abs(u_nodes).max())
+                    results.runs.append(Run(label, float(wall), int(n_dofs), series, errors,
+                                            {"level": lev, "h": hl, "nodes": p.num_nodes}))
             if rank == 0:
                 gmsh.model.remove()
     finally:

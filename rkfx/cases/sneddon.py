@@ -43,7 +43,11 @@ matched error (the time-to-accuracy table).
 Parameters (``--set NAME=VALUE``, consistent units): E, nu, p, L, c, crack_particles, bands,
 support_factor, residual, fem_degrees, fem_h, fem_tip, fem_levels.
 
-    python -m rkfx.cases.sneddon [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
+    python -m rkfx.cases.sneddon [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR] [--vtk]
+
+With ``--vtk`` every run writes its fields (at the load's time t = 1) to OUT/vtk/: RKPM
+(``rkpm-<band>-n<n>``) displacement, pressure, damage, crack opening w (5.13), strain and effective
+stress at the particles and on their rectangular cells; FEM (``fem-p<degree>-level<l>``) displacement.
 """
 import math
 import sys
@@ -57,7 +61,7 @@ from verification.sneddon import Sneddon
 
 from rkfx.approximation.shape_functions import evaluate, rk_approximation
 from rkfx.assembly.smeared_strain import row_strains
-from rkfx.cases import _cli, _preflight
+from rkfx.cases import _cli, _paraview, _preflight
 from rkfx.cases._cli import Param, Results, Run
 from rkfx.conditions import Displacement, Pressure, Region
 from rkfx.errors import InputError
@@ -67,6 +71,7 @@ from rkfx.integration.quadrature import scni
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.models.hydro_damage import crack_apertures, crack_bands, damaged_fields
 from rkfx.models.poroelasticity import PoroMaterial, solve_biot
+from rkfx.output.paraview import nodal_cells
 
 NAME = "sneddon"
 BANDS = ("strip", "supports", "row")
@@ -170,8 +175,9 @@ def _map_points(xs: np.ndarray) -> np.ndarray:
     return (keep[:, None] * len(xs) + keep[None, :]).ravel()
 
 
-def solve_rkpm(band: str, n: int, *, E, nu, p, L, c, support_factor, residual, comm=None) -> dict:
-    """The smeared crack of ``n`` particle columns: opening profile, centre COD, area, fields."""
+def solve_rkpm(band: str, n: int, *, E, nu, p, L, c, support_factor, residual, comm=None, vtk=None) -> dict:
+    """The smeared crack of ``n`` particle columns: opening profile, centre COD, area, fields;
+    with ``vtk`` a folder, the particle fields are written there as ``rkpm-<band>-n<n>``."""
     t0 = time.perf_counter()
     h, N = _grid(L, c, n)
     xs = -L / 2 + h * np.arange(N + 1)
@@ -202,6 +208,11 @@ def solve_rkpm(band: str, n: int, *, E, nu, p, L, c, support_factor, residual, c
     stiff = fields.D[shown]
     sig = np.einsum("ij,ij->i", stiff[:, 1, :], strain[shown]) - values[shown] @ P
     wall = time.perf_counter() - t0
+    if vtk is not None:
+        every_stress = np.einsum("nij,nj->ni", fields.D, strain)
+        _paraview.snapshot(vtk, f"rkpm-{band}-n{n}", particles.x, nodal_cells(domains), 1.0, comm,
+                           displacement=values @ U, pressure=values @ P, damage=damage, crack_opening=w,
+                           strain=strain * [1.0, 1.0, 0.5], effective_stress=every_stress)
     return {"h": h, "nodes": particles.num_nodes, "n_dofs": sol.n_dofs, "wall": wall,
             "x": xs[on], "cod": cod[on], "centre": float(cod[N // 2]), "area": float(cod.sum() * h),
             "cracked": int(damage.sum()), "map_x": particles.x[shown], "map_uy": (values[shown] @ U)[:, 1],
@@ -232,8 +243,9 @@ def _deviations(centre: float, area: float, x, cod, exact: Sneddon, ref: dict | 
 
 def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0, nu=0.25, p=1.0e-4, L=4.0, c=0.5,
         crack_particles=(9, 19, 39, 79), bands=("strip", "supports"), support_factor=1.5, residual=1e-6, fem_degrees=(1, 2),
-        fem_h=0.2, fem_tip=0.02, fem_levels=4) -> Results:
-    """The FEM slit levels, then the RKPM bands at every level; see the module docstring."""
+        fem_h=0.2, fem_tip=0.02, fem_levels=4, vtk=None) -> Results:
+    """The FEM slit levels, then the RKPM bands at every level; see the module docstring. ``vtk``:
+    a folder for the ParaView files of every run (``--vtk``)."""
     check(E=E, nu=nu, p=p, L=L, c=c, crack_particles=crack_particles, bands=bands, support_factor=support_factor,
           residual=residual, fem_degrees=fem_degrees, fem_h=fem_h, fem_tip=fem_tip, fem_levels=fem_levels)
     exact = Sneddon(E, nu, p, c)
@@ -246,7 +258,12 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0, nu=0.25, p=1.0e-4, L
     if "fem" in methods:
         for degree in sorted(fem_degrees):
             for level in range(fem_levels):
-                r = solve_fem(degree, level, E=E, nu=nu, p=p, L=L, c=c, fem_h=fem_h, fem_tip=fem_tip, comm=comm)
+                with _cli.model_run(f"fem-p{degree} level {level}"):
+                    r = solve_fem(degree, level, E=E, nu=nu, p=p, L=L, c=c, fem_h=fem_h, fem_tip=fem_tip, comm=comm)
+                series = _paraview.fem_series(vtk, f"fem-p{degree}-level{level}", r.solution.mesh)
+                if series is not None:
+                    with series:
+                        series.write(1.0, displacement=r.solution.u)
                 fem.append((degree, level, r))
         top = max(fem_degrees)
         best = fem[-1][2]
@@ -257,8 +274,9 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0, nu=0.25, p=1.0e-4, L
     if "rkpm" in methods:
         for band in bands:
             for n in crack_particles:
-                s = solve_rkpm(band, n, E=E, nu=nu, p=p, L=L, c=c, support_factor=support_factor,
-                               residual=residual, comm=comm)
+                with _cli.model_run(f"rkpm-{band} n={n}"):
+                    s = solve_rkpm(band, n, E=E, nu=nu, p=p, L=L, c=c, support_factor=support_factor,
+                                   residual=residual, comm=comm, vtk=vtk)
                 rkpm.append((band, n, s))
     finest = {b: max(crack_particles) for b in bands}
     shown = None

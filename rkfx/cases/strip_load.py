@@ -32,7 +32,11 @@ t_D_profile [-], t_D_end [-], depth_history [m], steps_low, variants (list), low
 (list), fem (list), support_factor [-].
 
     python -m rkfx.cases.strip_load [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
-        [--checkpoint-every N] [--resume DIR]
+        [--checkpoint-every N] [--resume DIR] [--vtk]
+
+With ``--vtk`` every run writes displacement, pressure, strain and effective stress to OUT/vtk/
+(RKPM: particles and nodal cells; FEM: dolfinx VTK files): the drained runs at t_D_profile and
+t_D_end, the low-permeability runs (``<run>-low-k``) after their last step.
 
 With ``--checkpoint-every N`` every run (RKPM and FEM) writes its state every N steps (and at its end) to
 OUT/checkpoints/; ``--resume DIR`` continues a killed invocation from DIR/checkpoints/, finished
@@ -52,7 +56,7 @@ from rkfx.errors import InputError
 from rkfx.geometry.particles import graded
 from rkfx.models.poroelasticity import VARIANTS, PoroMaterial, solve_biot
 from rkfx.solvers.integrate import time_grid
-from rkfx.cases import _cli, _preflight
+from rkfx.cases import _cli, _paraview, _preflight
 from rkfx.cases._cli import Param, Results, Run
 
 NAME = "strip_load"
@@ -151,8 +155,10 @@ def memory_need(methods, *, nx, ny, **_) -> _preflight.Need:
     return _preflight.poro_need(methods, nx * ny, f"nx={nx}, ny={ny}", "lower nx or ny")
 
 
-def _solve(method, xs, ys, material, q, b, times, outputs, samples, drained, support_factor, io):
-    """Pressure (k, m) and displacement (k, m, 2) at the samples, wall time, unknowns."""
+def _solve(method, xs, ys, material, q, b, times, outputs, samples, drained, support_factor, io, vtk=None,
+           vtk_name="", vtk_times=None):
+    """Pressure (k, m) and displacement (k, m, 2) at the samples, wall time, unknowns; with ``vtk``
+    a folder, the fields at ``vtk_times`` [s] are written there as ``vtk_name``."""
     # Fixed bottom, rollers on the sides, the surface drained or not: for RKPM and FEM alike.
     held = [Displacement("bottom"), Displacement("left", components=(0,)), Displacement("right", components=(0,))]
     held += [Pressure("top")] if drained else []
@@ -163,6 +169,8 @@ def _solve(method, xs, ys, material, q, b, times, outputs, samples, drained, sup
         sol = solve_biot(p, material, times, outputs, displacements=kinds[Displacement], pressures=kinds[Pressure],
                          tractions=[load], variant=method[5:], support_factor=support_factor,
                          comm=_cli.comm(), progress=lambda it: _cli.progress(it, method, len(times) - 1), **io)
+        if vtk is not None:
+            _paraview.write_biot(vtk, vtk_name, p, sol, material.elastic, _cli.comm(), vtk_times)
         return sol.pressure(samples), sol.displacement(samples), sol.wall_time_s, sol.n_dofs
     import dolfinx_solver  # noqa: F401, PLC0415
 
@@ -174,16 +182,21 @@ def _solve(method, xs, ys, material, q, b, times, outputs, samples, drained, sup
     # The load on the strip's facets only: RKPM's step in x, interpolated, would load the next facet too.
     strip = lambda x: (np.abs(x[:, 1] - ys[-1]) <= tol) & (x[:, 0] <= b + tol)  # noqa: E731
     bcs = held + [Traction(strip, (0.0, -q))]
+    series = _paraview.fem_series(vtk, vtk_name, mesh, vtk_times)
     res = fb.solve_biot(mesh, material.E, material.nu, material.k, material.alpha, material.S, element, bcs,
-                        times, samples, outputs, **io)
+                        times, samples, outputs, vtk=series,
+                        progress=lambda it: _cli.progress(it, method, len(times) - 1), **io)
+    if series is not None:
+        series.close()
     return res.p, res.u, res.wall_time_s, res.n_dofs
 
 
 def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.0, k=5.0e-8 / 9.8e3, k_low=5.0e-13 / 9.8e3,
         q=1.0e4, b=0.2, extent=25.0, nx=31, ny=31, dt_D=0.025, t_D_profile=0.1, t_D_end=2.0, depth_history=0.2,
         steps_low=4, variants=("scni+fpp", "ni"), low_variants=("ni", "scni+fpp"), fem=("taylor-hood", "q1q1-fpp"),
-        support_factor=1.5, checkpoint_every=0, work_dir=None, resume=None) -> Results:
-    """Both studies for every requested method; see the module docstring."""
+        support_factor=1.5, checkpoint_every=0, work_dir=None, resume=None, vtk=None) -> Results:
+    """Both studies for every requested method; see the module docstring. ``vtk``: a folder for the
+    ParaView files (``--vtk``)."""
     ck = _cli.Checkpoints(checkpoint_every, work_dir, resume)
     _check(nx, ny, dt_D, t_D_profile, t_D_end, extent, b, q, steps_low, variants, low_variants, fem,
            support_factor, depth_history)
@@ -214,8 +227,9 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.0, k=5.0e-8 /
               ([f"fem-{e}" for e in fem] if "fem" in methods else [])
     i_prof = int(np.searchsorted(t_hist, t_prof))
     for label in drained:
-        p_h, _, wall, dofs = _solve(label, xs, ys, material, q, b, times, t_hist, samples, True, support_factor,
-                                    ck.for_run(label))
+        with _cli.model_run(label):
+            p_h, _, wall, dofs = _solve(label, xs, ys, material, q, b, times, t_hist, samples, True, support_factor,
+                                        ck.for_run(label), vtk, label, [t_prof, t_end])
         prof, histp = p_h[i_prof, :-1], p_h[:, -1]
         results.runs.append(Run(
             label, wall, dofs,
@@ -231,8 +245,10 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.0, k=5.0e-8 /
     field_pts = np.column_stack([gx.ravel(), gy.ravel()])
     low_methods = [f"rkpm-{v}" for v in low_variants] if "rkpm" in methods else []
     for label in low_methods:
-        p_h, u_h, wall, dofs = _solve(label, xs, ys, low, q, b, t_low, t_low[-1:], field_pts, False,
-                                      support_factor, ck.for_run(f"{label}-low-permeability"))
+        with _cli.model_run(f"{label} (low k)"):
+            p_h, u_h, wall, dofs = _solve(label, xs, ys, low, q, b, t_low, t_low[-1:], field_pts, False,
+                                          support_factor, ck.for_run(f"{label}-low-permeability"), vtk,
+                                          f"{label}-low-k", t_low[-1:])
         pf = p_h[0].reshape(gx.shape)
         # Checkerboard measure: mean |second difference| of p between neighbouring nodes, over q.
         jump = (np.abs(np.diff(pf, 2, axis=0)).mean() + np.abs(np.diff(pf, 2, axis=1)).mean()) / (2 * q)
@@ -270,9 +286,15 @@ def plot(results: Results, out: Path) -> list[Path]:
         ax.grid(alpha=0.3)
         ax2.semilogx(r0.series["t_D"], np.asarray(r0.series["p_history_exact"]) / q, color="k", lw=2.5, alpha=0.4,
                      label="exact")
+        exact = np.asarray(r0.series["p_history_exact"]) / q
+        lo, hi = min(exact.min(), 0.0), exact.max()
+        window = (lo - 0.3 * (hi - lo), hi + 0.3 * (hi - lo))  # an unstable run must not hide the others
         for j, r in enumerate(drained):
-            ax2.semilogx(r.series["t_D"], np.asarray(r.series["p_history"]) / q, marker=markers[j % 5], ms=3,
-                         mfc="none", lw=0.8, label=r.method)
+            ph = np.asarray(r.series["p_history"]) / q
+            outside = bool(np.any((ph < window[0]) | (ph > window[1])))
+            ax2.semilogx(r.series["t_D"], ph, marker=markers[j % 5], ms=3, mfc="none", lw=0.8,
+                         label=r.method + (f" (leaves the plot: {ph.min():.3g} to {ph.max():.3g})" if outside else ""))
+        ax2.set_ylim(*window)
         ax2.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax2.set_xlabel("T_D = E k t / ((1 + nu) b^2) [-]")
         ax2.set_ylabel("p / q [-]")

@@ -165,7 +165,8 @@ def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_f
                              "triangle" if element == "taylor-hood" else "quadrilateral")
     series = _paraview.fem_series(vtk, method, mesh)
     res = fb.solve_biot(mesh, material.E, material.nu, material.k, material.alpha, material.S, element, bcs,
-                        times, samples, outputs, vtk=series, **io)
+                        times, samples, outputs, vtk=series,
+                        progress=lambda it: _cli.progress(it, method, len(times) - 1), **io)
     if series is not None:
         series.close()
     return res.p, res.wall_time_s, res.n_dofs
@@ -199,8 +200,9 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e3, nu=0.0, k=1.0e-9, 
                                  refine_ny=list(refine_ny), support_factor=support_factor, p0=p0, c_v=exact.c_v,
                                  steps=len(times) - 1))
     for label in labels:
-        p_h, wall, dofs = _solve(label, W, H, nx, ny, material, q, times, outputs, samples, support_factor,
-                                 ck.for_run(label), vtk)
+        with _cli.model_run(label):
+            p_h, wall, dofs = _solve(label, W, H, nx, ny, material, q, times, outputs, samples, support_factor,
+                                     ck.for_run(label), vtk)
         first = p_h[0] / p0
         errors = {"first_step_max_dev_away": float(np.abs(first - p_exact[0] / p0)[away].max()),
                   "first_step_overshoot": float(first.max() - 1.0),
@@ -214,8 +216,9 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e3, nu=0.0, k=1.0e-9, 
     for label in refine:
         for n in refine_ny:
             mx = _refined_nx(nx, ny, n)
-            p_h, wall, dofs = _solve(label, W, H, mx, n, material, q, np.array([0.0, dt]), [dt], samples,
-                                     support_factor, ck.for_run(f"{label}-ny{n}"))
+            with _cli.model_run(f"{label} ny={n}"):
+                p_h, wall, dofs = _solve(label, W, H, mx, n, material, q, np.array([0.0, dt]), [dt], samples,
+                                         support_factor, ck.for_run(f"{label}-ny{n}"))
             results.runs.append(Run(f"{label} ny={n}", wall, dofs,
                                     series={"z": z, "t": [dt], "p": p_h, "p_exact": p_exact[:1]},
                                     errors={"first_step_l2": float(np.linalg.norm(p_h[0] - p_exact[0])

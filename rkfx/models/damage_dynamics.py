@@ -231,15 +231,44 @@ class DamageDynamics(ExplicitDynamics):
         super().__init__(mass, self.force, dt, external_force, constraints, self.field.arrays)
 
 
+@dataclass
+class Frames:
+    """The fields of a run through time, for output (e.g. ParaView): ``write(t, **fields)`` is
+    called at ``count`` evenly spaced history samples and at the end, with ``damage`` and
+    ``crack_opening`` (w / w_c) per damage point and ``displacement``, ``velocity`` per node,
+    shape ``(n, 2)``, whole on every rank. ``run_damage`` sets ``gather`` and ``gather_nodes``.
+    A resumed run writes the frames of the piece it computes."""
+
+    write: Callable[..., None]
+    count: int = 20
+    written: int = 0
+    gather: Callable[[np.ndarray], np.ndarray] = np.copy
+    gather_nodes: Callable[[np.ndarray], np.ndarray] = np.copy
+
+    def last(self, r: "DamageRun") -> None:
+        """The end state of ``r``, a finished run read back, if no frame was written."""
+        if self.written == 0:
+            n = len(r.displacement) // 2
+            self.write(r.steps * r.dt, damage=r.damage, crack_opening=r.opening,
+                       displacement=r.displacement.reshape(n, 2), velocity=r.velocity.reshape(n, 2))
+            self.written += 1
+
+
 class _Samples:
     """The sampled history of a damage run (the stepper's recorder): time, dissipated energy,
     damaged points and energies at every output, and the stepping time so far across the
     pieces of a resumed run; its arrays are checkpointed with the run."""
 
     def __init__(self, dynamics: DamageDynamics, steps: int, every: int,
-                 total: Callable[[np.ndarray], np.ndarray] | None = None):
+                 total: Callable[[np.ndarray], np.ndarray] | None = None, frames: Frames | None = None,
+                 progress: Callable[[int], None] | None = None):
         self.field, self.model = dynamics.field, dynamics.damage_model
+        self.progress = progress
         self.total = total  # sums a rank's (dissipated, damaged) over the ranks
+        self.frames = frames
+        self.frame_every = 1 if frames is None else max(1, (steps // every + 1) // max(1, frames.count))
+        self.frame_time = -np.inf  # the time of the last frame written
+        self.frame_seconds = 0.0  # spent writing frames: not stepping time
         self.history = np.full((steps // every + 2, len(HISTORY)), np.nan)
         self.slot = np.zeros(1, np.int64)
         self.wall = np.zeros(1)
@@ -249,13 +278,28 @@ class _Samples:
     def record(self, s: ExplicitState) -> None:
         if self.base is None:
             self.base = float(self.wall[0])
-        self.wall[0] = self.base + time.perf_counter() - self.t0
+        self.wall[0] = self.base + time.perf_counter() - self.t0 - self.frame_seconds
         e = s.energy
         damage = np.array([self.field.dissipated(self.model), self.field.damaged.sum()], float)
         if self.total is not None:
             damage = self.total(damage)
         self.history[self.slot[0]] = (s.time, damage[0], damage[1], e[0], e[1], e[2] + e[3])
+        if self.frames is not None and self.slot[0] % self.frame_every == 0:
+            self.frame(s)
         self.slot[0] += 1
+        if self.progress is not None:
+            self.progress(s.step)
+
+    def frame(self, s: ExplicitState) -> None:
+        """Hand the fields at ``s`` to the frame writer (collective: the fields are gathered)."""
+        t0 = time.perf_counter()
+        f, whole, nodes = self.field, self.frames.gather, self.frames.gather_nodes
+        opening = crack_opening(f.kappa, self.model.kappa0, f.kappa_c)
+        self.frames.write(s.time, damage=whole(f.damage), crack_opening=whole(opening),
+                          displacement=nodes(s.d).reshape(-1, 2), velocity=nodes(s.v).reshape(-1, 2))
+        self.frame_time = s.time
+        self.frames.written += 1
+        self.frame_seconds += time.perf_counter() - t0
 
     def arrays(self) -> dict[str, np.ndarray]:
         return {"history": self.history, "slot": self.slot, "wall": self.wall}
@@ -266,7 +310,7 @@ class _Samples:
     @property
     def elapsed(self) -> float:
         """Stepping time of the run so far, earlier pieces included [s]."""
-        return (self.base or 0.0) + time.perf_counter() - self.t0
+        return (self.base or 0.0) + time.perf_counter() - self.t0 - self.frame_seconds
 
 
 # --------------------------------------------------------------------------- runs
@@ -332,7 +376,8 @@ def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, mode
                track: Tracking | None, constraints: Sequence[Constraint], t_end: float,
                external_force: Callable[[float], np.ndarray] | None = None, samples: int = 200,
                checkpoint_every: int = 0, work_dir: Path | None = None, resume: Path | None = None,
-               comm=None, x: np.ndarray | None = None) -> DamageRun:
+               comm=None, x: np.ndarray | None = None, frames: Frames | None = None,
+               progress: Callable[[int], None] | None = None) -> DamageRun:
     """Explicit dynamics with the damage of ``model`` to ``t_end`` (``samples`` history points),
     keeping finished work.
 
@@ -352,13 +397,17 @@ def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, mode
             the serial result bit for bit, on every rank); other runs are serial: rank 0 runs
             them and writes the files, and every rank receives the result (or the error).
         x: Particle positions, shape ``(n, 2)`` [m], which the ranks split by RCB.
+        frames: Receives the fields through time (``Frames``); a finished run read back writes
+            its end state.
+        progress: Called with the step number at every history sample (e.g. a progress bar).
     """
     parallel = comm is not None and comm.size > 1
     if isinstance(op, StrainRecipe) and not (parallel and x is not None):
         op = op.build()  # one process builds the whole operator
     if parallel and (x is None or not isinstance(op, SmearedStrain | StrainRecipe)):
         return on_root(comm, lambda: run_damage(label, op, mass, dt, model, track, constraints, t_end,
-                                                external_force, samples, checkpoint_every, work_dir, resume))
+                                                external_force, samples, checkpoint_every, work_dir, resume,
+                                                frames=frames, progress=progress))
     if not t_end > 0:
         raise InputError(f"t_end = {t_end!r} must be positive (seconds)")
     if checkpoint_every and work_dir is None:
@@ -375,6 +424,8 @@ def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, mode
             log.warning("resume: %s; continuing %s from its checkpoint", str(err).split(";")[0], label)
         else:
             log.info("resume: %s read back finished (%s)", label, finished)
+            if frames is not None:
+                frames.last(done)
             return done
     steps = int(np.ceil(t_end / dt - 1e-9))
     every = max(1, steps // samples)
@@ -392,13 +443,17 @@ def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, mode
         dynamics = DamageDynamics(op, mass, model, track, dt, constraints, external_force)
         whole = whole_nodes = np.copy
         total = None
-    kept = _Samples(dynamics, steps, every, total)
+    if frames is not None:
+        frames.gather, frames.gather_nodes = whole, whole_nodes
+    kept = _Samples(dynamics, steps, every, total, frames, progress)
     res = CentralDifference(dt).run(dynamics, steps, output_every=every, recorder=kept,
                                     checkpoint_every=checkpoint_every, checkpoint_dir=checkpoint_dir, resume=start)
     elapsed = kept.elapsed
     history, slot, field, points = kept.history, kept.slot, dynamics.field, dynamics.damage_model
     if slot[0] == 0 or history[slot[0] - 1, 0] < steps * dt * (1 - 1e-12):
         kept.record(res.state)
+    if frames is not None and kept.frame_time < res.state.time:
+        kept.frame(res.state)
     run = DamageRun(label, history[:slot[0]].copy(), whole(field.damage), whole(field.kappa), whole(field.normal),
                     whole(field.initiation_time), whole(crack_opening(field.kappa, points.kappa0, field.kappa_c)),
                     whole(field.dissipation(points)), whole_nodes(res.state.d), whole_nodes(res.state.v), steps, dt,

@@ -272,6 +272,10 @@ class HydraulicFractureModel:
         """p^h at the particles for the unknowns ``x`` [Pa], shape ``(n,)``."""
         return self._values @ x[2 * self.n:]
 
+    def displacements(self, x: np.ndarray) -> np.ndarray:
+        """u^h at the particles for the unknowns ``x`` [m], shape ``(n, 2)``."""
+        return self._values @ x[:2 * self.n].reshape(-1, 2)
+
     def _loads(self, t: float) -> tuple[np.ndarray, np.ndarray]:
         """F^ext and Q^ext at t: boundary tractions and fluxes, and the injected fluid."""
         f, q = self._boundary_loads(t)

@@ -16,6 +16,9 @@ there).
     series = FieldSeries("out/vtk", "rkpm", particles.x, cells=nodal_cells(particles))
     series.write(0.5, displacement=u, pressure=p)
     # paraview out/vtk/rkpm_particles.pvd
+
+A ``MeshSeries`` writes fields on a mesh of triangles or quadrilaterals (vertex and cell data),
+e.g. the crack-band FEM baselines' damage per element.
 """
 import os
 import re
@@ -27,6 +30,11 @@ from rkfx.errors import InputError
 from rkfx.fracture.damage import CellGeometry, cell_geometry
 from rkfx.geometry.nodal_domains import NodalDomains
 from rkfx.geometry.particles import Particles
+
+
+def file_stem(label: str) -> str:
+    """A run label as a file name: ``rkpm-dpm n=150`` -> ``rkpm-dpm_n150``."""
+    return str(label).replace("=", "").replace(" ", "_").replace("/", "-")
 
 
 def nodal_cells(p: Particles | NodalDomains) -> CellGeometry:
@@ -77,7 +85,7 @@ class FieldSeries:
     """
 
     def __init__(self, folder, name: str, points: np.ndarray, cells: CellGeometry | None = None, comm=None):
-        self.folder, self.name = Path(folder), str(name).replace("/", "-")
+        self.folder, self.name = Path(folder), file_stem(name)
         self.points = np.asarray(points, float)
         self.cells = cells
         self.writes = comm is None or comm.rank == 0
@@ -116,3 +124,48 @@ class FieldSeries:
         meshio.write(self.folder / file, mesh, binary=True)
         self.entries[kind].append((float(time), file))
         write_pvd(self.folder / f"{self.name}_{kind}.pvd", self.entries[kind])
+
+
+class MeshSeries:
+    """Fields on a mesh of triangles (or quadrilaterals) through time: point data at its
+    vertices, cell data on its cells, one ``NAME_K.vtu`` per time and the index ``NAME.pvd``.
+
+    Args:
+        folder: Output folder (created).
+        name: Prefix of the files.
+        points: Vertex coordinates, shape ``(n, 2)`` [m].
+        cells: Vertex indices per cell, shape ``(m, 3)`` or ``(m, 4)``.
+        comm: MPI communicator; only its rank 0 writes. ``None``: this process writes.
+    """
+
+    def __init__(self, folder, name: str, points: np.ndarray, cells: np.ndarray, comm=None):
+        self.folder, self.name = Path(folder), file_stem(name)
+        self.points, self.cells = np.asarray(points, float), np.asarray(cells, np.int64)
+        if self.cells.ndim != 2 or self.cells.shape[1] not in (3, 4):
+            raise InputError(f"cells of shape {self.cells.shape}: give (m, 3) triangles or (m, 4) quadrilaterals")
+        self.writes = comm is None or comm.rank == 0
+        self.entries: list[tuple[float, str]] = []
+        if self.writes:
+            self.folder.mkdir(parents=True, exist_ok=True)
+
+    @property
+    def pvd(self) -> Path:
+        """The time index, the file to open in ParaView."""
+        return self.folder / f"{self.name}.pvd"
+
+    def write(self, time: float, point_data: dict | None = None, cell_data: dict | None = None) -> None:
+        """Write the fields at ``time`` [s]: ``point_data`` per vertex, ``cell_data`` per cell
+        (scalars, 2-vectors or Voigt tensors as for ``FieldSeries``)."""
+        if not self.writes:
+            return
+        import meshio  # noqa: PLC0415
+
+        n, m = len(self.points), len(self.cells)
+        kind = "triangle" if self.cells.shape[1] == 3 else "quad"
+        mesh = meshio.Mesh(np.column_stack([self.points, np.zeros(n)]), [(kind, self.cells)],
+                           point_data={k: _vtk_values(k, v, n) for k, v in (point_data or {}).items()},
+                           cell_data={k: [_vtk_values(k, v, m)] for k, v in (cell_data or {}).items()})
+        file = f"{self.name}_{len(self.entries):05d}.vtu"
+        meshio.write(self.folder / file, mesh, binary=True)
+        self.entries.append((float(time), file))
+        write_pvd(self.pvd, self.entries)
