@@ -207,7 +207,8 @@ print(f"figures in {OUT}; lab ran in {elapsed:.1f} s")
 # For the deformed shape add *Filters → Warp By Vector* on `displacement` with a scale factor
 # of about 100. From a shell, `paraview lab_output/05_vtk/kalthoff_cells.pvd` opens it directly.
 # The cases write the same files with `--vtk` (e.g. `python -m rkfx.cases.terzaghi --quick --vtk`).
-#
+
+# %% [markdown]
 # ## Exercises
 #
 # 1. Run to the case's full $t_{end} = 80\,\mu$s and with 60 particles per side. Does the
