@@ -5,7 +5,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.rkfx-installed
 DEMO   ?= mandel
 
-.PHONY: demo test test-slow test-mpi bench env clean
+.PHONY: demo test test-slow test-mpi bench labs env clean
 
 demo: $(STAMP)
 	$(PY) -m rkfx.cases.$(DEMO)
@@ -19,6 +19,16 @@ test-slow: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) bench/core_build.py
+
+# The teaching labs (docs/labs/*.py, jupytext percent scripts) as notebooks in build/labs/.
+# The notebooks are generated, never committed; the .py files are the source.
+LABS := $(wildcard docs/labs/*.py)
+labs: $(STAMP)
+	@mkdir -p build/labs
+	@for lab in $(LABS); do \
+	  $(PY) -m jupytext --to ipynb --output build/labs/$$(basename $$lab .py).ipynb $$lab || exit 1; \
+	done
+	@echo "notebooks in build/labs/ (open with: jupyter lab build/labs)"
 
 env: $(STAMP)
 
@@ -35,4 +45,4 @@ $(STAMP): pyproject.toml tools/find-python tools/rkfx-mpi.pth tools/rkfx_mpi_fir
 	@touch $(STAMP)
 
 clean:
-	rm -rf $(VENV) results .pytest_cache
+	rm -rf $(VENV) results .pytest_cache build lab_output
