@@ -553,6 +553,31 @@ def plot(results: Results, out: Path) -> list[Path]:
     return files
 
 
+from rkfx.report.claims import Claim  # noqa: E402  (the seed's claims this case checks: rkfx.report)
+
+_REG = {"study": "regularized", "cells": "voronoi"}
+CLAIMS = [
+    Claim("Fig 4.8(b), (4.9): the damage particle method breaks at u_T^max = 2 G_F / f_t within 0.5 % at every n",
+          info=_REG, key="u_T_max_rel_error", op="within", bound=(-5e-3, 5e-3)),
+    Claim("Fig 4.8(b), (4.28): dissipated energy is G_F A (0.999 G_F A with the weak section) within 0.5 % at every n",
+          info=_REG, key="dissipated_over_GF_A", op="within", bound=(0.994, 1.004)),
+    Claim("Fig 4.10(b): the crack opens fully, the bar carries no force at the end (F < 1e-6 f_t A)",
+          info=_REG, key="F_end_over_ft_A", op="<", bound=1e-6),
+    Claim("Fig 4.8(a): without regularization the dissipation falls with refinement (32 nodes < 16 nodes / 1.5)",
+          run="rkpm-scni-unregularized n=32", key="dissipated", op="<", bound=1 / 1.5,
+          over=("rkpm-scni-unregularized n=16", {})),
+    Claim("Fig 4.8(a): without regularization the dissipation falls with refinement (128 nodes < 64 nodes / 1.5)",
+          run="rkpm-scni-unregularized n=128", key="dissipated", op="<", bound=1 / 1.5,
+          over=("rkpm-scni-unregularized n=64", {}), full_only=True),
+    Claim("Fig 4.11(b): SCNI smeared strain gives a constant stress along the bar (max deviation < 0.1 %)",
+          info=_REG, key="stress_max_dev", op="<", bound=1e-3),
+    Claim("Fig 4.11(a): 8-point Gauss with direct gradients oscillates (max stress deviation > 1 %)",
+          info={"study": "stress"}, key="stress_max_dev", op=">", bound=1e-2),
+    Claim("Sec 4.3.1: the crack-band FEM beside it breaks at 2 G_F / f_t within 1 %",
+          info={"study": "fem"}, key="u_T_max_rel_error", op="within", bound=(-1e-2, 1e-2)),
+]
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point (see the module docstring)."""
     return _cli.main(NAME, __doc__, PARAMS, run, plot, argv, QUICK, checkpoints=True)

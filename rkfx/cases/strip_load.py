@@ -306,6 +306,23 @@ def plot(results: Results, out: Path) -> list[Path]:
     return files
 
 
+from rkfx.report.claims import Claim  # noqa: E402  (the seed's claims this case checks: rkfx.report)
+
+CLAIMS = [
+    Claim("Fig 3.11: SCNI+FPP pressure on the axis at T_D = 0.1 within 5 % (relative L2) of the exact solution",
+          run="rkpm-scni+fpp", info={"study": "drained"}, key="l2_p_axis", op="<", bound=0.05),
+    Claim("Fig 3.12: SCNI+FPP pressure history at 0.2 m depth within 2 % of q of the exact solution",
+          run="rkpm-scni+fpp", info={"study": "drained"}, key="max_err_history", op="<", bound=0.02),
+    Claim("Fig 3.11: FEM Taylor-Hood pressure on the axis within 5 % (relative L2) of the exact solution",
+          run="fem-taylor-hood", info={"study": "drained"}, key="l2_p_axis", op="<", bound=0.05),
+    Claim("Fig 3.12: NI is less accurate than SCNI+FPP: its history error is more than 3x larger",
+          run="rkpm-ni", info={"study": "drained"}, key="max_err_history", op=">", bound=3.0,
+          over=("rkpm-scni+fpp", {"study": "drained"})),
+    Claim("Fig 3.13: low permeability, NI's pressure oscillates: its checkerboard measure > 4x that of SCNI+FPP",
+          run="rkpm-ni (low k)", key="p_second_difference", op=">", bound=4.0, over=("rkpm-scni+fpp (low k)", {})),
+]
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point (see the module docstring)."""
     return _cli.main(NAME, __doc__, PARAMS, run, plot, argv, QUICK, checkpoints=True)
