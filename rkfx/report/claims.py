@@ -2,7 +2,8 @@
 
 A case module lists its claims as ``CLAIMS = [Claim(...), ...]``. A claim names the run(s) it
 is about (``run``: the method label, exact, or ``None`` for any; ``info``: values the run's
-``info`` must have), the ``errors`` key measured there, a comparison and its bound:
+``info`` must have), the key measured there (in the run's ``errors``, else in its ``info``),
+a comparison and its bound:
 
     Claim("Fig 3.5: SCNI+FPP first-step pressure within 5 % of the series away from the top",
           run="rkpm-scni+fpp", info={"study": "variants"}, key="first_step_max_dev_away",
@@ -129,6 +130,18 @@ def _finite(v) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
+_MISSING = object()
+
+
+def value_of(run: Mapping, key: str):
+    """``run["errors"][key]``, else ``run["info"][key]`` (a missing key: a sentinel, never a number)."""
+    for part in ("errors", "info"):
+        values = run.get(part) or {}
+        if key in values:
+            return values[key]
+    return _MISSING
+
+
 def evaluate(claim: Claim, results: Mapping | None, quick: bool) -> Outcome:
     """The verdict of ``claim`` on one case's results (``None``: the case produced none)."""
     if (claim.quick_only and not quick) or (claim.full_only and quick):
@@ -144,17 +157,16 @@ def evaluate(claim: Claim, results: Mapping | None, quick: bool) -> Outcome:
         others = select(runs, *claim.over)
         if len(others) != 1:
             return Outcome(claim, FAIL, note=f"{len(others)} runs match {_selector(*claim.over)} (need one)")
-        divisor = (others[0].get("errors") or {}).get(claim.over_key or claim.key)
+        divisor = value_of(others[0], claim.over_key or claim.key)
         if not _finite(divisor) or divisor == 0:
-            return Outcome(claim, FAIL, note=f"{claim.over_key or claim.key} of {_selector(*claim.over)} "
-                                             f"is {divisor!r}")
+            what = "missing" if divisor is _MISSING else f"{divisor!r}"
+            return Outcome(claim, FAIL, note=f"{claim.over_key or claim.key} of {_selector(*claim.over)} is {what}")
     values, bad = [], []
     for r in chosen:
-        v = (r.get("errors") or {}).get(claim.key)
+        v = value_of(r, claim.key)
         if not _finite(v):
             values.append(None)
-            bad.append(f"{r.get('method')}: {claim.key} " + ("missing" if claim.key not in (r.get("errors") or {})
-                                                             else "not a finite number"))
+            bad.append(f"{r.get('method')}: {claim.key} " + ("missing" if v is _MISSING else f"is {v!r}"))
             continue
         v = v / divisor
         values.append(v)
