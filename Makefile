@@ -5,7 +5,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.rkfx-installed
 DEMO   ?= mandel
 
-.PHONY: demo test test-slow test-mpi bench env clean
+.PHONY: demo test test-slow test-mpi bench report env clean
 
 demo: $(STAMP)
 	$(PY) -m rkfx.cases.$(DEMO)
@@ -19,6 +19,10 @@ test-slow: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) bench/core_build.py
+
+# Every case at its --quick sizes, the seed's claims checked, one page: results/report/index.html.
+report: $(STAMP)
+	$(PY) -m rkfx.report --quick --out results/report
 
 env: $(STAMP)
 

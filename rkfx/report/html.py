@@ -46,9 +46,13 @@ def num(v) -> str:
     return "-" if not math.isfinite(v) else f"{v:.3g}"
 
 
-def table(head: Sequence[str], rows: Sequence[Sequence], classes: Sequence[Sequence[str]] | None = None) -> str:
-    """An HTML table; cells are escaped; ``classes`` gives each cell's CSS class."""
-    out = ['<div class="wide"><table>', "<tr>" + "".join(f"<th>{esc(h)}</th>" for h in head) + "</tr>"]
+def table(head: Sequence[str] | None, rows: Sequence[Sequence],
+          classes: Sequence[Sequence[str]] | None = None) -> str:
+    """An HTML table (``head``: column titles, or ``None``); cells are escaped; ``classes`` gives
+    each cell's CSS class."""
+    out = ['<div class="wide"><table>']
+    if head:
+        out.append("<tr>" + "".join(f"<th>{esc(h)}</th>" for h in head) + "</tr>")
     for i, row in enumerate(rows):
         cells = []
         for j, c in enumerate(row):
@@ -82,7 +86,8 @@ def runs_table(runs: Sequence[Mapping]) -> str:
     rows, classes = [], []
     for r in runs:
         errs = r.get("errors") or {}
-        rows.append([r.get("method"), num(r.get("n_dofs")), num(r.get("wall_time_s")), *(num(errs.get(k)) for k in keys)])
+        rows.append([r.get("method"), num(r.get("n_dofs")), num(r.get("wall_time_s")),
+                     *(num(errs.get(k)) for k in keys)])
         classes.append(["", "num", "num", *(["num"] * len(keys))])
     return table(["method", "dofs", "wall [s]", *keys], rows, classes)
 
@@ -147,7 +152,8 @@ def case_section(case, outcomes: Sequence[Outcome], page_dir: Path) -> str:
     passed, checked = counts(outcomes)
     parts = [f'<h2 id="{esc(case.name)}">{esc(case.name)} <span class="{status}">{status}</span></h2>',
              f"<p>claims passed {passed}/{checked}; wall time {case.wall_time_s:.1f} s; folder "
-             f'<a href="{esc(case.name)}/">{esc(case.name)}/</a> (log: <a href="{esc(case.name)}/log.txt">log.txt</a>)</p>']
+             f'<a href="{esc(case.name)}/">{esc(case.name)}/</a> '
+             f'(log: <a href="{esc(case.name)}/log.txt">log.txt</a>)</p>']
     if case.failed:
         parts.append(f'<p class="FAILED">FAILED: {esc(case.error)}</p>')
         parts.append(f"<pre>{esc(case.log_tail) or '(empty log)'}</pre>")
@@ -176,7 +182,7 @@ def page(cases: Sequence, outcomes: Mapping[str, Sequence[Outcome]], header: Map
         classes.append(["", status, "num", "num"])
     summary = table(["case", "verdict", "claims passed", "wall [s]"], rows, classes)
     links = " · ".join(f'<a href="#{esc(c.name)}">{esc(c.name)}</a>' for c in cases)
-    head = table(["", ""], [[k, v] for k, v in header.items()])
+    head = table(None, [[k, v] for k, v in header.items()])
     body = [f"<h1>rkfx benchmark report</h1>", head, "<h2>Summary</h2>", summary, f"<p>{links}</p>",
             *(case_section(c, outcomes[c.name], page_dir) for c in cases)]
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
