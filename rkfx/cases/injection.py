@@ -372,6 +372,7 @@ def plot(results: Results, out: Path) -> list[Path]:
 
 from rkfx.report.claims import Claim  # noqa: E402  (the seed's claims this case checks: rkfx.report)
 
+# Measured at the --quick sizes only (the default sizes are not yet run through): see the module docstring.
 CLAIMS = [
     Claim("Fig 5.6: the crack grows symmetrically along the notch (wing asymmetry < 10 %) at every refinement",
           key="wing_asymmetry", op="<", bound=0.1),
@@ -385,8 +386,8 @@ CLAIMS = [
     Claim("Fig 5.7: two refinements give nearly identical pressure (relative L2 difference < 20 %)",
           run="rkpm h=0.025", key="p_l2_vs_coarser", op="<", bound=0.2, quick_only=True),
     Claim("Sec 5.2.2 (5.33): Newton converges in at most 10 iterations per step",
-          key="max_iterations", op="<=", bound=10),
-    Claim("Sec 5.2.2: no time step had to be cut", key="cuts", op="==", bound=0),
+          key="max_iterations", op="<=", bound=10, quick_only=True),
+    Claim("Sec 5.2.2: no time step had to be cut", key="cuts", op="==", bound=0, quick_only=True),
 ]
 
 
