@@ -372,11 +372,11 @@ def plot(results: Results, out: Path) -> list[Path]:
 
 from rkfx.report.claims import Claim  # noqa: E402  (the seed's claims this case checks: rkfx.report)
 
-# Measured at the --quick sizes only (the default sizes are not yet run through): see the module docstring.
+# Bounds measured at the --quick sizes; the default sizes are still to be run (docs/hydraulic_fracture.md).
 CLAIMS = [
     Claim("Fig 5.6: the crack grows symmetrically along the notch (wing asymmetry < 10 %) at every refinement",
           key="wing_asymmetry", op="<", bound=0.1),
-    Claim("Fig 5.6: the fluid pressure drives the crack out of the notch (crack length 0.325 m > 2c + 2h at "
+    Claim("Fig 5.6: the fluid pressure drives the crack out of the notch (crack length > 2c + 2h at "
           "2000 s, h = 0.025 m)", run="rkpm h=0.025", key="length_end", op=">", bound=0.25, quick_only=True),
     Claim("Sec 5.3.2: propagation starts after the LEFM estimate for an impermeable rock (809 s), as the pore "
           "pressure fills the rock", run="rkpm h=0.025", key="onset_t", op=">", bound=809.7, quick_only=True),
