@@ -5,7 +5,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.rkfx-installed
 DEMO   ?= mandel
 
-.PHONY: demo test test-slow test-mpi bench labs env clean
+.PHONY: demo test test-slow test-mpi bench labs report env clean
 
 demo: $(STAMP)
 	$(PY) -m rkfx.cases.$(DEMO)
@@ -29,6 +29,10 @@ labs: $(STAMP)
 	  $(PY) -m jupytext --to ipynb --output build/labs/$$(basename $$lab .py).ipynb $$lab || exit 1; \
 	done
 	@echo "notebooks in build/labs/ (open with: jupyter lab build/labs)"
+
+# Every case at its --quick sizes, the seed's claims checked, one page: results/report/index.html.
+report: $(STAMP)
+	$(PY) -m rkfx.report --quick --out results/report
 
 env: $(STAMP)
 

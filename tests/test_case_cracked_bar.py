@@ -112,7 +112,7 @@ def test_median_dual_cells_break_late():
                             geometry=s.geometry)
     assert cracked_bar.weak_points(s, 100.0).sum() == 4
     u_peak = cracked_bar.elastic_limit(s, model)
-    path = cracked_bar.load_path(s, model, cracked_bar._targets(u_peak, WC, 60, 1.6))
+    path = cracked_bar.load_path(s, model, cracked_bar.load_targets(u_peak, WC, 60, 1.6))
     assert 1.4 < dm.failure_displacement(path.u, path.force) / WC < 1.55
     assert abs(path.dissipated[-1] / (0.999 * GF_A) - 1) < 5e-3
 

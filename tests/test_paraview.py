@@ -177,6 +177,10 @@ def test_case_vtk_files_hold_the_documented_fields(case, tmp_path, capsys):
                 assert 0.0 <= data["damage"].min() and data["damage"].max() <= 1.0
             for key in data.keys():
                 assert np.isfinite(data[key]).all(), (name, key)
+    if case == "kalthoff":  # the impacted edge moves at v0: velocities are u^h, not RK coefficients
+        _, parts = _read(out / "vtk" / "rkpm-dpm_n60_particles.pvd", times_of(out / "vtk" / "rkpm-dpm_n60_particles.pvd")[-1])
+        edge = (parts.points[:, 0] < 1e-12) & (parts.points[:, 1] < 0.02)
+        np.testing.assert_allclose(parts.point_data["velocity"][edge, 0], 16.5, rtol=1e-6)
     cells = next(out.glob("vtk/*_cells.pvd"), None)
     if cells is not None and case != "plate_with_hole":  # the rectangular models: cells tile the box
         _, mesh = _read(cells, times_of(cells)[-1])

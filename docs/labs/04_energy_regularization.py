@@ -42,7 +42,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from rkfx.cases.cracked_bar import load_path, weak_points  # noqa: E402
+from rkfx.cases.cracked_bar import load_path, load_targets, weak_points  # noqa: E402
 from rkfx.fracture import damage as dm  # noqa: E402
 from rkfx.models.damage_bar import elastic_limit, strip  # noqa: E402
 from verification.cohesive_bar import CohesiveBar  # noqa: E402
@@ -91,8 +91,7 @@ print(f"constant kappa_c = {kappa_c_const:.4e} (= {kappa_c_const / material.kapp
 
 # %%
 def targets(u_peak: float, steps: int = 30) -> np.ndarray:
-    first = u_peak * (1.0 + 0.1 * (1.0 / 0.999 - 1.0))
-    return np.r_[0.98 * u_peak, first, np.linspace(0.98 * u_peak, 1.02 * wc, steps + 1)[1:]]
+    return load_targets(u_peak, wc, steps, 1.02)  # the case's schedule
 
 
 paths = {}

@@ -31,7 +31,7 @@ from rkfx.models.damage_dynamics import DamageRun, run_damage
 from rkfx.geometry.grid_cells import grid_domains
 from rkfx.geometry.nodal_domains import NodalDomains
 from rkfx.geometry.particles import Particles, graded
-from rkfx.approximation.shape_functions import RKApproximation, rk_approximation
+from rkfx.approximation.shape_functions import RKApproximation, evaluate, rk_approximation
 from rkfx.solvers.central_difference import Constraint
 from rkfx.cases import _paraview, _preflight
 from rkfx.cases._terminal import model_run, step_progress
@@ -123,7 +123,8 @@ def simulate(label: str, pl: Plate, model: dm.DamageModel, track: Tracking | Non
     """The damage particle method on the plate to ``t_end`` (``rkfx.models.damage_dynamics.run_damage``;
     with an MPI ``comm`` of several ranks, distributed over them); with ``vtk`` a folder, the
     fields through time are written there for ParaView (``_paraview.damage_frames``)."""
-    frames = _paraview.damage_frames(vtk, label, pl.p.x, _paraview.nodal_cells(pl.domains), comm)
+    frames = None if vtk is None else _paraview.damage_frames(
+        vtk, label, pl.p.x, _paraview.nodal_cells(pl.domains), evaluate(pl.rk, pl.p.x).matrix(), comm)
     bar = step_progress(label, int(np.ceil(t_end / pl.dt - 1e-9)))
     try:
         return run_damage(label, pl.op, pl.mass, pl.dt, model, track, constraints, t_end, external_force, samples,

@@ -46,14 +46,22 @@ def snapshot(folder: Path, label: str, points, cells, t: float, comm=None, **fie
     return series
 
 
-def damage_frames(folder: Path | None, label: str, points, cells, comm=None, count: int = 20) -> Frames | None:
+def damage_frames(folder: Path | None, label: str, points, cells, values, comm=None,
+                  count: int = 20) -> Frames | None:
     """The frame writer of a damage run (``rkfx.models.damage_dynamics.Frames``) on particles (with
     their ``nodal_cells``), or ``None`` without ``--vtk``: damage, crack opening w / w_c,
-    displacement [m] and velocity [m/s] at ``count`` times and the end."""
+    displacement u^h [m] and velocity [m/s] at ``count`` times and the end. ``values``: the
+    shape functions at the particles, shape ``(n, n)`` (the run's coefficients are not nodal values)."""
     if folder is None:
         return None
     series = FieldSeries(folder, label, points, cells=cells, comm=comm)
-    return Frames(series.write, count)
+
+    def write(t, damage, crack_opening, displacement, velocity):
+        if series.writes:
+            series.write(t, damage=damage, crack_opening=crack_opening, displacement=values @ displacement,
+                         velocity=values @ velocity)
+
+    return Frames(write, count)
 
 
 def crack_band_frames(folder: Path | None, label: str, count: int = 20):

@@ -79,6 +79,7 @@ from rkfx.models.damage_dynamics import DamageRun
 from rkfx.cases import _cli, _paraview, _preflight
 from rkfx.cases import _dynamic_fracture as dyn
 from rkfx.cases._cli import Param, Results, Run
+from rkfx.report.claims import Claim
 
 NAME = "crack_branching"
 LX, LY, A1, A2 = 0.1, 0.04, 0.05, 0.02
@@ -369,6 +370,33 @@ def plot(results: Results, out: Path) -> list[Path]:
     if path:
         files.append(path)
     return files
+
+
+_DPM = {"study": "rkpm-dpm"}
+CLAIMS = [
+    Claim("Fig 4.18(a): at h = 0.8 mm the crack branches into two major branches",
+          info={"study": "rkpm-dpm", "h_nominal": 8e-4}, key="branches", op="==", bound=2),
+    Claim("Fig 4.18(a): the branches split ahead of the initial tip (x = 50 mm) and before x = 80 mm",
+          info={"study": "rkpm-dpm", "h_nominal": 8e-4}, key="branch_x", op="within", bound=(0.05, 0.08)),
+    Claim("Fig 4.18: the crack runs from the tip to the right, past x = 80 mm, at every refinement",
+          info=_DPM, key="tip_x", op=">", bound=0.08, quick_only=True),
+    Claim("Fig 4.19: the regularized dissipation changes < 0.5x as much as the unregularized one on refinement",
+          run="rkpm-dpm", info={"study": "summary"}, key="dissipation_change_fine", op="<", bound=0.5,
+          over=("rkpm-dpm-unregularized", {"study": "summary"})),
+    Claim("Fig 4.19(b): the regularized dissipation converges, change over the last halving of h < 10 %",
+          run="rkpm-dpm", info={"study": "summary"}, key="dissipation_change_fine", op="<", bound=0.10,
+          full_only=True),
+    Claim("Fig 4.19(a): without regularization the dissipation falls on refinement (h = 0.8 mm < 0.8x h = 1.6 mm)",
+          info={"study": "rkpm-dpm-unregularized", "h_nominal": 8e-4}, key="dissipated_end", op="<", bound=0.8,
+          over=(None, {"study": "rkpm-dpm-unregularized", "h_nominal": 1.6e-3}), quick_only=True),
+    Claim("Fig 4.19(a): without regularization the dissipation falls on refinement (h = 0.4 mm < 0.8x h = 0.8 mm)",
+          info={"study": "rkpm-dpm-unregularized", "h_nominal": 4e-4}, key="dissipated_end", op="<", bound=0.8,
+          over=(None, {"study": "rkpm-dpm-unregularized", "h_nominal": 8e-4}), full_only=True),
+    Claim("Sec 4.3: explicit central differences keep the energy balance of the damage particle method within 0.1 %",
+          info=_DPM, key="energy_error", op="<", bound=1e-3),
+    Claim("Sec 4.3.3: the crack-band FEM baseline beside it keeps its energy balance within 0.1 %",
+          info={"study": "fem"}, key="energy_error", op="<", bound=1e-3),
+]
 
 
 def main(argv: Sequence[str] | None = None) -> int:

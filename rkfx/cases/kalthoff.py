@@ -79,6 +79,7 @@ from rkfx.models.damage_dynamics import DamageRun
 from rkfx.cases import _cli, _paraview, _preflight
 from rkfx.cases import _dynamic_fracture as dyn
 from rkfx.cases._cli import Param, Results, Run
+from rkfx.report.claims import Claim
 
 NAME = "kalthoff"
 SIDE, A1, A2 = 0.1, 0.05, 0.025
@@ -354,6 +355,27 @@ def plot(results: Results, out: Path) -> list[Path]:
     if path:
         files.append(path)
     return files
+
+
+_DPM = {"study": "rkpm-dpm"}
+CLAIMS = [
+    Claim("Fig 4.13-4.14: the crack leaves at about 70 deg as in the experiment: 60-75 deg at every refinement",
+          info=_DPM, key="crack_angle_deg", op="within", bound=(60.0, 75.0)),
+    Claim("Fig 4.15(b): objective dissipation with the regularization (4.28): spread over the refinements < 10 %",
+          run="rkpm-dpm", info={"study": "summary"}, key="dissipation_spread", op="<", bound=0.10),
+    Claim("Fig 4.15(a): without regularization the dissipation depends on the grid: its spread > 2x the "
+          "regularized one", run="rkpm-dpm-unregularized", info={"study": "summary"}, key="dissipation_spread",
+          op=">", bound=2.0, over=("rkpm-dpm", {"study": "summary"})),
+    Claim("Fig 4.13: with particle tracking (4.22) no particle cracks below the crack plane",
+          info=_DPM, key="cracked_below_crack_plane", op="<=", bound=0),
+    Claim("Fig 4.16: without tracking spurious damage appears away from the crack front (> 10 cracked particles "
+          "below the crack plane)", info={"study": "rkpm-dpm-no-tracking"}, key="cracked_below_crack_plane",
+          op=">", bound=10),
+    Claim("Sec 4.3: explicit central differences keep the energy balance of the damage particle method within 0.2 %",
+          info=_DPM, key="energy_error", op="<", bound=2e-3),
+    Claim("Sec 4.3.2: the crack-band FEM baseline beside it dissipates energy (crack grows without tracking)",
+          info={"study": "fem"}, key="dissipated_end", op=">", bound=0.0),
+]
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -60,6 +60,7 @@ from rkfx.models.poroelasticity import VARIANTS, PoroMaterial, solve_biot
 from rkfx.solvers.integrate import time_grid
 from rkfx.cases import _cli, _paraview, _preflight
 from rkfx.cases._cli import Param, Results, Run
+from rkfx.report.claims import Claim
 
 NAME = "mandel"
 FEM_ELEMENTS = ("taylor-hood", "q1q1", "q1q1-fpp")
@@ -303,6 +304,21 @@ def plot(results: Results, out: Path) -> list[Path]:
         fig.tight_layout()
         files.append(_cli.save(fig, out / "early_time.png"))
     return files
+
+
+CLAIMS = [
+    *(Claim(f"Fig 3.9: {m} pressure along y = 0 within 3 % (relative L2) of the exact solution at T_D = {t:g}",
+            run=m, key=f"l2_p_TD{t:g}", op="<=", bound=0.03, full_only=t > 0.1)
+      for m in ("rkpm-scni+fpp", "fem-taylor-hood") for t in (0.01, 0.1, 0.5)),
+    Claim("Fig 3.9: Mandel-Cryer effect, the centre pressure of SCNI+FPP rises above 1.1 p0+",
+          run="rkpm-scni+fpp", key="cryer_peak", op=">", bound=1.1),
+    Claim("Fig 3.8 (top): SCNI+FPP stable at early time, overshoot <= 5 % of p0+ with 20 steps of dt_D = 0.01",
+          run="rkpm-scni+fpp", key="early_dtD0.01_overshoot", op="<=", bound=0.05),
+    Claim("Fig 3.8 (top): NI oscillates at early time, overshoot > 20 % of p0+ with 20 steps of dt_D = 0.01",
+          run="rkpm-ni", key="early_dtD0.01_overshoot", op=">", bound=0.20),
+    Claim("Fig 3.8 (top): NI oscillates even when FPP is applied, overshoot > 1 % of p0+ at dt_D = 0.01",
+          run="rkpm-ni+fpp", key="early_dtD0.01_overshoot", op=">", bound=0.01, full_only=True),
+]
 
 
 def main(argv: Sequence[str] | None = None) -> int:

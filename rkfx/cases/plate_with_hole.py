@@ -54,6 +54,7 @@ from rkfx.integration.norms import relative_errors
 from rkfx.integration.quadrature import RULES
 from rkfx.cases import _cli, _paraview, _preflight
 from rkfx.cases._cli import Param, Results, Run
+from rkfx.report.claims import Claim
 
 NAME = "plate_with_hole"
 HOLE_REFINEMENT = 3.0  # mesh size on the hole = h / HOLE_REFINEMENT
@@ -382,6 +383,25 @@ def plot(results: Results, out: Path) -> list[Path]:
     fig.suptitle(f"Nodal displacement error, finest mesh ({finest[methods[0]].info['nodes']} nodes)")
     files.append(_cli.save(fig, out / "error_field.png"))
     return files
+
+
+# No seed figure: Kirsch's plate checks the SCNI / MSCNI elasticity of Sec 3.3.2 (3.56)-(3.59) on gmsh geometry.
+CLAIMS = [
+    Claim("Sec 3.3.2 (3.56)-(3.59): MSCNI displacement within 0.15 % (relative L2) of Kirsch's, h = 0.5 m",
+          run="rkpm-mscni", info={"level": 0}, key="l2", op="<", bound=1.5e-3),
+    Claim("Sec 3.3.2: MSCNI H1-seminorm error below 3.5 % on the coarsest mesh",
+          run="rkpm-mscni", info={"level": 0}, key="h1", op="<", bound=3.5e-2),
+    Claim("Kirsch: MSCNI stress concentration sigma_xx(0, a) = 3T within 10 %",
+          run="rkpm-mscni", key="sxx_hole_err", op="<", bound=0.1),
+    Claim("FEM P2 baseline on the same mesh: L2 error < 0.2 %",
+          run="fem-p2", info={"level": 0}, key="l2", op="<", bound=2e-3),
+    Claim("FEM P1 baseline on the same mesh: L2 error < 1.2 %",
+          run="fem-p1", info={"level": 0}, key="l2", op="<", bound=1.2e-2),
+    Claim("MSCNI is more accurate than P1 on the same nodes (L2 error ratio < 0.5)",
+          run="rkpm-mscni", info={"level": 0}, key="l2", op="<", bound=0.5, over=("fem-p1", {"level": 0})),
+    Claim("Sec 3.3.2: MSCNI converges, L2 rate > 1.8 from h = 0.5 to 0.25 m",
+          run="rkpm-mscni", info={"level": 1}, key="rate_l2", op=">", bound=1.8, full_only=True),
+]
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -63,6 +63,7 @@ from rkfx.approximation.shape_functions import evaluate, rk_approximation
 from rkfx.assembly.smeared_strain import row_strains
 from rkfx.cases import _cli, _paraview, _preflight
 from rkfx.cases._cli import Param, Results, Run
+from rkfx.report.claims import Claim
 from rkfx.conditions import Displacement, Pressure, Region
 from rkfx.errors import InputError
 from rkfx.geometry.grid_cells import grid_domains
@@ -420,6 +421,30 @@ def plot(results: Results, out: Path) -> list[Path]:
         path.write_text("\n".join(lines) + "\n")
         files.append(path)
     return files
+
+
+CLAIMS = [
+    Claim("(5.37): the discrete FEM slit in the fixed square opens 6-15 % less than Sneddon's unbounded crack",
+          info={"study": "fem"}, key="centre_vs_sneddon", op="within", bound=(-0.15, -0.06)),
+    Claim("Fig 5.3: the smeared crack converges upon refinement: centre COD error vs the slit falls by > 2x "
+          "from 9 to 19 particles along the crack", run="rkpm-strip n=19", key="centre_vs_slit", op="within",
+          bound=(0.0, 0.5), over=("rkpm-strip n=9", {})),
+    Claim("Fig 5.3: smeared crack centre COD within 3 % of the discrete slit at h = 2c/19",
+          run="rkpm-strip n=19", key="centre_vs_slit", op="within", bound=(-0.03, 0.03), quick_only=True),
+    Claim("Fig 5.3: smeared crack area within 1 % of the discrete slit at h = 2c/19",
+          run="rkpm-strip n=19", key="area_vs_slit", op="within", bound=(-0.01, 0.01), quick_only=True),
+    Claim("Fig 5.3: smeared COD profile within 2.5 % (relative L2) of the discrete slit at h = 2c/19",
+          run="rkpm-strip n=19", key="cod_l2_vs_slit", op="<", bound=0.025, quick_only=True),
+    Claim("Fig 5.3: smeared crack centre COD within 1 % of the discrete slit at h = 2c/79",
+          run="rkpm-strip n=79", key="centre_vs_slit", op="within", bound=(-0.01, 0.01), full_only=True),
+    Claim("Fig 5.3: smeared crack area within 1 % of the discrete slit at h = 2c/79",
+          run="rkpm-strip n=79", key="area_vs_slit", op="within", bound=(-0.01, 0.01), full_only=True),
+    Claim("Fig 5.3: smeared COD profile within 2 % (relative L2) of the discrete slit at h = 2c/79",
+          run="rkpm-strip n=79", key="cod_l2_vs_slit", op="<", bound=0.02, full_only=True),
+    Claim("Fig 5.2: the band of particles whose supports cover the crack models a longer crack; its area "
+          "excess over the slit shrinks by > 40 % from 9 to 19 particles", run="rkpm-supports n=19",
+          key="area_vs_slit", op="within", bound=(0.0, 0.6), over=("rkpm-supports n=9", {})),
+]
 
 
 def main(argv: Sequence[str] | None = None) -> int:

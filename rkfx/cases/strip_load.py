@@ -58,6 +58,7 @@ from rkfx.models.poroelasticity import VARIANTS, PoroMaterial, solve_biot
 from rkfx.solvers.integrate import time_grid
 from rkfx.cases import _cli, _paraview, _preflight
 from rkfx.cases._cli import Param, Results, Run
+from rkfx.report.claims import Claim
 
 NAME = "strip_load"
 FEM_ELEMENTS = ("taylor-hood", "q1q1", "q1q1-fpp")
@@ -326,6 +327,21 @@ def plot(results: Results, out: Path) -> list[Path]:
         fig.suptitle(f"Low permeability, impermeable surface: fields after {prm['steps_low']} steps")
         files.append(_cli.save(fig, out / "undrained_fields.png", dpi=110))
     return files
+
+
+CLAIMS = [
+    Claim("Fig 3.11: SCNI+FPP pressure on the axis at T_D = 0.1 within 5 % (relative L2) of the exact solution",
+          run="rkpm-scni+fpp", info={"study": "drained"}, key="l2_p_axis", op="<", bound=0.05),
+    Claim("Fig 3.12: SCNI+FPP pressure history at 0.2 m depth within 2 % of q of the exact solution",
+          run="rkpm-scni+fpp", info={"study": "drained"}, key="max_err_history", op="<", bound=0.02),
+    Claim("Fig 3.11: FEM Taylor-Hood pressure on the axis within 5 % (relative L2) of the exact solution",
+          run="fem-taylor-hood", info={"study": "drained"}, key="l2_p_axis", op="<", bound=0.05),
+    Claim("Fig 3.12: NI is less accurate than SCNI+FPP: its history error is more than 3x larger",
+          run="rkpm-ni", info={"study": "drained"}, key="max_err_history", op=">", bound=3.0,
+          over=("rkpm-scni+fpp", {"study": "drained"})),
+    Claim("Fig 3.13: low permeability, NI's pressure oscillates: its checkerboard measure > 4x that of SCNI+FPP",
+          run="rkpm-ni (low k)", key="p_second_difference", op=">", bound=4.0, over=("rkpm-scni+fpp (low k)", {})),
+]
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -57,6 +57,7 @@ from rkfx.models.poroelasticity import VARIANTS, PoroMaterial, solve_biot
 from rkfx.solvers.integrate import time_grid
 from rkfx.cases import _cli, _paraview, _preflight
 from rkfx.cases._cli import Param, Results, Run
+from rkfx.report.claims import Claim
 
 NAME = "terzaghi"
 FEM_ELEMENTS = ("taylor-hood", "q1q1", "q1q1-fpp")
@@ -294,6 +295,28 @@ def plot(results: Results, out: Path) -> list[Path]:
         fig.tight_layout()
         files.append(_cli.save(fig, out / "refinement.png"))
     return files
+
+
+CLAIMS = [
+    Claim("Fig 3.5: SCNI+FPP first-step pressure within 5 % of Terzaghi's solution away from the drained layer",
+          run="rkpm-scni+fpp", info={"study": "variants"}, key="first_step_max_dev_away", op="<=", bound=0.05),
+    Claim("Fig 3.5: NI alone gives severe pressure oscillations (deviation > 50 % of p0)",
+          run="rkpm-ni", info={"study": "variants"}, key="first_step_max_dev_away", op=">", bound=0.5),
+    Claim("Fig 3.5: SCNI alone gives severe pressure oscillations (deviation > 50 % of p0)",
+          run="rkpm-scni", info={"study": "variants"}, key="first_step_max_dev_away", op=">", bound=0.5),
+    Claim("Fig 3.5: FPP with NI only partly removes the oscillation: its deviation > 2x that of SCNI+FPP",
+          run="rkpm-ni+fpp", info={"study": "variants"}, key="first_step_max_dev_away", op=">", bound=2.0,
+          over=("rkpm-scni+fpp", {"study": "variants"})),
+    Claim("Sec 3.4.1: SCNI+FPP overshoot near the drainage boundary is minor (< 10 % of p0)",
+          run="rkpm-scni+fpp", info={"study": "variants"}, key="first_step_overshoot", op="<", bound=0.10),
+    Claim("Sec 3.4.1: the overshoot also appears with stable finite elements (Taylor-Hood > 10 % of p0)",
+          run="fem-taylor-hood", info={"study": "variants"}, key="first_step_overshoot", op=">", bound=0.10),
+    Claim("Fig 3.6: refining 21 -> 41 nodes along the height lowers the first-step L2 error of SCNI+FPP",
+          run="rkpm-scni+fpp ny=41", key="first_step_l2", op="<", bound=1.0, over=("rkpm-scni+fpp ny=21", {})),
+    Claim("Fig 3.6: refining 41 -> 81 nodes along the height lowers the first-step L2 error of SCNI+FPP",
+          run="rkpm-scni+fpp ny=81", key="first_step_l2", op="<", bound=1.0, over=("rkpm-scni+fpp ny=41", {}),
+          full_only=True),
+]
 
 
 def main(argv: Sequence[str] | None = None) -> int:

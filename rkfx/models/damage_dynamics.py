@@ -235,8 +235,9 @@ class DamageDynamics(ExplicitDynamics):
 class Frames:
     """The fields of a run through time, for output (e.g. ParaView): ``write(t, **fields)`` is
     called at ``count`` evenly spaced history samples and at the end, with ``damage`` and
-    ``crack_opening`` (w / w_c) per damage point and ``displacement``, ``velocity`` per node,
-    shape ``(n, 2)``, whole on every rank. ``run_damage`` sets ``gather`` and ``gather_nodes``.
+    ``crack_opening`` (w / w_c) per damage point and the coefficients ``displacement``, ``velocity``
+    per node, shape ``(n, 2)`` (nodal values for finite elements, not for RK shape functions),
+    whole on every rank. ``run_damage`` sets ``gather`` and ``gather_nodes``.
     A resumed run writes the frames of the piece it computes."""
 
     write: Callable[..., None]
