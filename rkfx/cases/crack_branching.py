@@ -166,14 +166,20 @@ def traction_force(pl: dyn.Plate, sigma: float) -> np.ndarray:
     return traction_load(pl.p, bq, [Traction("top", pull), Traction("bottom", pull)])
 
 
-def _rkpm(label, study, h, material, prm, regularized=True, kappa_c=None, **io) -> Run:
+def setup(h: float, material: dm.DamageMaterial, prm: dict, regularized: bool = True, kappa_c: float | None = None,
+          comm=None) -> tuple[dyn.Plate, object, dm.DamageModel, np.ndarray]:
+    """The plate of spacing ``h``, its tracking (seeded by the four particles around the tip),
+    damage model and edge force, for the parameters ``prm`` (``PARAMS`` names)."""
     xs, ys = grid(h)
     pl = dyn.plate(xs, ys, [((0.0, A2), (A1, A2))], [(False, True)], material, prm["rho"], prm["support_factor"],
-                   prm["courant"], prm["eps_p"], io.get("comm"))
+                   prm["courant"], prm["eps_p"], comm)
     seeds = np.linalg.norm(pl.p.x - np.array([A1, A2]), axis=1) < 0.75 * pl.h
     track = tracking(pl.p.x, pl.p.spacing, prm["tol"], seeds, prm["radius"], forward=prm["forward"])
-    model = dyn.damage_model(pl, material, regularized, kappa_c)
-    f = traction_force(pl, prm["sigma"])
+    return pl, track, dyn.damage_model(pl, material, regularized, kappa_c), traction_force(pl, prm["sigma"])
+
+
+def _rkpm(label, study, h, material, prm, regularized=True, kappa_c=None, **io) -> Run:
+    pl, track, model, f = setup(h, material, prm, regularized, kappa_c, io.get("comm"))
     r = dyn.simulate(label, pl, model, track, [], prm["t_end"], external_force=lambda t: f, **io)
     return _run_record(r, study, h, pl, 2 * pl.p.num_nodes)
 

@@ -1,0 +1,19 @@
+"""The branching sensitivity study measures what the case's figure shows on a coarse plate."""
+import pytest
+
+from verification import branching_sensitivity as study
+
+
+def test_measurements_of_a_coarse_run_add_up():
+    m = study.measure(1.6e-3, {})
+    assert m["branches"] >= 1 and m["side_by_side"] >= m["branches"] - 1
+    assert m["crack"] > 0 and m["onset"] >= 0
+    assert m["crack"] + m["onset"] == pytest.approx(m["dissipated"])
+    assert m["kappa_c_over_kappa0"] > 1  # regularized: kappa_c above the threshold (4.28)
+    assert m["x_two_mm"] is None or m["x_two_mm"] >= m["split_mm"]
+
+
+def test_an_unknown_variant_is_refused_in_one_line(capsys, tmp_path):
+    assert study.main(["--variants", "defaults,eps=3", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "'eps=3'" in err[0] and "eps_p=0" in err[0]

@@ -1,0 +1,101 @@
+"""How the crack-branching run at fine spacings responds to the method's parameters (issue: chapter 4
+at the finest resolutions). Measures, per spacing h and variant of one parameter, what the figure
+shows and where the energy goes:
+
+* branches: the case's count on x = 80-95 mm; side by side: ``most_cracks``;
+* x_two [mm]: the largest grid column crossed by two or more separate cracks (how far the
+  branches run as a pair), first split x [mm];
+* mid-plane [mm]: the x extent of the cracked particles within 2 h of the crack plane y = a2
+  beyond the first split (a central crack);
+* crack / onset [J/m]: the dissipation in the cracked particles (w / w_c >= 0.5) and in the
+  rest (particles that initiated but barely opened);
+* kappa_c / kappa0: the regularized critical strain (4.28) over the threshold, median over the
+  particles that initiated.
+
+    python -m verification.branching_sensitivity [--h 4e-4,2e-4] [--out results/branching_sensitivity]
+
+Writes ``OUT/sensitivity.json`` and prints a markdown table (rows as they finish, so a stopped
+study keeps what it measured).
+"""
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from rkfx.cases import _dynamic_fracture as dyn
+from rkfx.cases import crack_branching as cb
+from rkfx.fracture import damage as dm
+
+VARIANTS = {  # name: the parameters that differ from the case's defaults
+    "defaults": {},
+    "eps_p=0": {"eps_p": 0.0},
+    "eps_p=2": {"eps_p": 2.0},
+    "tol=0.3": {"tol": 0.3},
+    "tol=0.7": {"tol": 0.7},
+    "courant=0.25": {"courant": 0.25},
+    "symmetric candidates": {"forward": False},
+}
+
+
+def measure(h: float, overrides: dict) -> dict:
+    """One regularized run of the case at spacing ``h`` [m] with ``overrides``; its measurements."""
+    prm = {k: p.default for k, p in cb.PARAMS.items()} | overrides
+    material = dm.DamageMaterial(prm["E"], prm["nu"], prm["ft"], prm["GF"], prm["plane"])
+    t0 = time.perf_counter()
+    pl, track, model, f = cb.setup(h, material, prm)
+    r = dyn.simulate("study", pl, model, track, [], prm["t_end"], external_force=lambda t: f)
+    branches, split, counts = cb.branch_metrics(r.opening, pl.xs, pl.ys)
+    columns = pl.xs[pl.xs > cb.A1]
+    two = columns[counts >= 2]
+    cracked = r.opening >= dyn.CRACKED
+    x = pl.p.x
+    mid = cracked & (np.abs(x[:, 1] - cb.A2) < 2 * pl.h) & (x[:, 0] > (split if np.isfinite(split) else cb.A1))
+    crack = float(r.dissipation[cracked].sum())
+    started = np.flatnonzero(r.kappa > model.kappa0)  # the particles that initiated
+    chords = dm.chord_lengths(model.geometry, started, r.normal[started])
+    ratio = dm.critical_strain(material, chords, model.volume[started]) / model.kappa0[started]
+    return {"h": h, "particles": pl.p.num_nodes, "branches": branches, "side_by_side": cb._most_cracks(counts, columns),
+            "x_two_mm": 1e3 * float(two.max()) if two.size else None,
+            "split_mm": 1e3 * split if np.isfinite(split) else None,
+            "mid_plane_mm": 1e3 * float(np.ptp(x[mid, 0])) if mid.sum() > 1 else 0.0,
+            "dissipated": float(r.history[-1, 1]), "crack": crack, "onset": float(r.history[-1, 1]) - crack,
+            "kappa_c_over_kappa0": float(np.median(ratio)) if ratio.size else None, "steps": r.steps, "wall_s": time.perf_counter() - t0}
+
+
+ROW = ("| {h:.1f} | {variant} | {branches} | {side_by_side} | {split} | {x_two} | {mid_plane_mm:.1f} | "
+       "{dissipated:.3f} | {crack:.3f} | {onset:.3f} | {share:.0%} | {kappa_c_over_kappa0:.1f} | {wall_s:.0f} |")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--h", default="4e-4,2e-4", help="spacings [m], comma-separated")
+    ap.add_argument("--variants", default=",".join(VARIANTS), help="which variants, comma-separated")
+    ap.add_argument("--out", type=Path, default=Path("results/branching_sensitivity"))
+    args = ap.parse_args(argv)
+    names = [v for v in args.variants.split(",") if v]
+    unknown = [v for v in names if v not in VARIANTS]
+    if unknown:
+        print(f"branching_sensitivity: unknown variant {unknown[0]!r}; choose from {', '.join(VARIANTS)}",
+              file=sys.stderr)
+        return 2
+    args.out.mkdir(parents=True, exist_ok=True)
+    rows = []
+    print("| h [mm] | variant | branches | side by side | split x [mm] | pair to x [mm] | mid-plane [mm] | "
+          "dissipated [J/m] | crack | onset | onset share | kappa_c/kappa0 | wall [s] |")
+    print("|" + "---|" * 13)
+    for h in (float(v) for v in args.h.split(",")):
+        for name in names:
+            m = measure(h, VARIANTS[name]) | {"variant": name}
+            rows.append(m)
+            (args.out / "sensitivity.json").write_text(json.dumps(rows, indent=1) + "\n")
+            print(ROW.format(**{**m, "h": 1e3 * h, "split": "-" if m["split_mm"] is None else f"{m['split_mm']:.1f}",
+                                "x_two": "-" if m["x_two_mm"] is None else f"{m['x_two_mm']:.1f}",
+                                "share": m["onset"] / m["dissipated"]}), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
