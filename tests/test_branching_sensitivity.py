@@ -11,6 +11,7 @@ def test_measurements_of_a_coarse_run_add_up():
     assert m["crack"] + m["onset"] == pytest.approx(m["dissipated"])
     assert m["kappa_c_over_kappa0"] > 1  # regularized: kappa_c above the threshold (4.28)
     assert m["x_two_mm"] is None or m["x_two_mm"] >= m["split_mm"]
+    assert sum(m["onset_by_distance"]) == pytest.approx(m["onset"])
 
 
 def test_an_unknown_variant_is_refused_in_one_line(capsys, tmp_path):

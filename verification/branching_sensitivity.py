@@ -9,6 +9,9 @@ shows and where the energy goes:
   beyond the first split (a central crack);
 * crack / onset [J/m]: the dissipation in the cracked particles (w / w_c >= 0.5) and in the
   rest (particles that initiated but barely opened);
+* onset by distance [J/m]: the onset energy of the particles within 1 mm, 1-3 mm and beyond
+  3 mm of the nearest cracked particle (fixed lengths, so that a zone of physical width keeps
+  its band under refinement and one of a few spacings moves towards the first);
 * kappa_c / kappa0: the regularized critical strain (4.28) over the threshold, median over the
   particles that initiated.
 
@@ -24,11 +27,13 @@ import time
 from pathlib import Path
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from rkfx.cases import _dynamic_fracture as dyn
 from rkfx.cases import crack_branching as cb
 from rkfx.fracture import damage as dm
 
+ONSET_BANDS = ((0.0, 1e-3), (1e-3, 3e-3), (3e-3, np.inf))  # distance to the nearest cracked particle [m]
 VARIANTS = {  # name: the parameters that differ from the case's defaults
     "defaults": {},
     "eps_p=0": {"eps_p": 0.0},
@@ -54,6 +59,10 @@ def measure(h: float, overrides: dict) -> dict:
     x = pl.p.x
     mid = cracked & (np.abs(x[:, 1] - cb.A2) < 2 * pl.h) & (x[:, 0] > (split if np.isfinite(split) else cb.A1))
     crack = float(r.dissipation[cracked].sum())
+    # Where the onset energy sits: distance of each uncracked particle to the nearest cracked one.
+    rest = np.flatnonzero(~cracked & (r.dissipation > 0))
+    far = cKDTree(x[cracked]).query(x[rest])[0] if cracked.any() and rest.size else np.zeros(rest.size)
+    bands = [float(r.dissipation[rest][(far >= lo) & (far < hi)].sum()) for lo, hi in ONSET_BANDS]
     started = np.flatnonzero(r.kappa > model.kappa0)  # the particles that initiated
     chords = dm.chord_lengths(model.geometry, started, r.normal[started])
     ratio = dm.critical_strain(material, chords, model.volume[started]) / model.kappa0[started]
@@ -62,11 +71,12 @@ def measure(h: float, overrides: dict) -> dict:
             "split_mm": 1e3 * split if np.isfinite(split) else None,
             "mid_plane_mm": 1e3 * float(np.ptp(x[mid, 0])) if mid.sum() > 1 else 0.0,
             "dissipated": float(r.history[-1, 1]), "crack": crack, "onset": float(r.history[-1, 1]) - crack,
-            "kappa_c_over_kappa0": float(np.median(ratio)) if ratio.size else None, "steps": r.steps, "wall_s": time.perf_counter() - t0}
+            "kappa_c_over_kappa0": float(np.median(ratio)) if ratio.size else None,
+            "onset_by_distance": bands, "steps": r.steps, "wall_s": time.perf_counter() - t0}
 
 
 ROW = ("| {h:.1f} | {variant} | {branches} | {side_by_side} | {split} | {x_two} | {mid_plane_mm:.1f} | "
-       "{dissipated:.3f} | {crack:.3f} | {onset:.3f} | {share:.0%} | {kappa_c_over_kappa0:.1f} | {wall_s:.0f} |")
+       "{dissipated:.3f} | {crack:.3f} | {onset:.3f} | {share:.0%} | {bands} | {kappa_c_over_kappa0:.1f} | {wall_s:.0f} |")
 
 
 def main(argv=None) -> int:
@@ -84,8 +94,9 @@ def main(argv=None) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     rows = []
     print("| h [mm] | variant | branches | side by side | split x [mm] | pair to x [mm] | mid-plane [mm] | "
-          "dissipated [J/m] | crack | onset | onset share | kappa_c/kappa0 | wall [s] |")
-    print("|" + "---|" * 13)
+          "dissipated [J/m] | crack | onset | onset share | onset < 1 / 1-3 / > 3 mm from a crack | kappa_c/kappa0 | "
+          "wall [s] |")
+    print("|" + "---|" * 14)
     for h in (float(v) for v in args.h.split(",")):
         for name in names:
             m = measure(h, VARIANTS[name]) | {"variant": name}
@@ -93,7 +104,8 @@ def main(argv=None) -> int:
             (args.out / "sensitivity.json").write_text(json.dumps(rows, indent=1) + "\n")
             print(ROW.format(**{**m, "h": 1e3 * h, "split": "-" if m["split_mm"] is None else f"{m['split_mm']:.1f}",
                                 "x_two": "-" if m["x_two_mm"] is None else f"{m['x_two_mm']:.1f}",
-                                "share": m["onset"] / m["dissipated"]}), flush=True)
+                                "share": m["onset"] / m["dissipated"],
+                                "bands": " / ".join(f"{v:.3f}" for v in m["onset_by_distance"])}), flush=True)
     return 0
 
 
