@@ -94,8 +94,8 @@ def main(argv=None) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     rows = []
     print("| h [mm] | variant | branches | side by side | split x [mm] | pair to x [mm] | mid-plane [mm] | "
-          "dissipated [J/m] | crack | onset | onset share | onset < 1 / 1-3 / > 3 mm from a crack | kappa_c/kappa0 | "
-          "wall [s] |")
+          "dissipated [J/m] | crack | onset | onset share | onset < 1 / 1-3 / > 3 mm from a crack | "
+          "kappa_c/kappa0 | wall [s] |")
     print("|" + "---|" * 14)
     for h in (float(v) for v in args.h.split(",")):
         for name in names:
