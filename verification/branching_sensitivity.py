@@ -76,7 +76,8 @@ def measure(h: float, overrides: dict) -> dict:
 
 
 ROW = ("| {h:.1f} | {variant} | {branches} | {side_by_side} | {split} | {x_two} | {mid_plane_mm:.1f} | "
-       "{dissipated:.3f} | {crack:.3f} | {onset:.3f} | {share:.0%} | {bands} | {kappa_c_over_kappa0:.1f} | {wall_s:.0f} |")
+       "{dissipated:.3f} | {crack:.3f} | {onset:.3f} | {share:.0%} | {bands} | {kappa_c_over_kappa0:.1f} | "
+       "{wall_s:.0f} |")
 
 
 def main(argv=None) -> int:

@@ -43,7 +43,8 @@ from typing import Any
 import numpy as np
 
 from rkfx.cases._preflight import before_work
-from rkfx.cases._terminal import _fmt_value, model_run, progress, step_progress, summary_table  # noqa: F401  (cases: _cli.*)
+# The cases call these as _cli.progress, _cli.model_run, ...
+from rkfx.cases._terminal import _fmt_value, model_run, progress, step_progress, summary_table  # noqa: F401
 from rkfx.errors import InputError, SolverError
 from rkfx.parallel.threads import share_cores
 from rkfx.solvers.checkpoint import has_checkpoint, run_folder
