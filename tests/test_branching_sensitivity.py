@@ -12,6 +12,7 @@ def test_measurements_of_a_coarse_run_add_up():
     assert m["kappa_c_over_kappa0"] > 1  # regularized: kappa_c above the threshold (4.28)
     assert m["x_two_mm"] is None or m["x_two_mm"] >= m["split_mm"]
     assert sum(m["onset_by_distance"]) == pytest.approx(m["onset"])
+    assert m["flank_per_cracked"] >= 0 and (m["flank_opening"] is None or 0 <= m["flank_opening"] < 0.5)
 
 
 def test_an_unknown_variant_is_refused_in_one_line(capsys, tmp_path):

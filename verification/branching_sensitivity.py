@@ -12,6 +12,8 @@ shows and where the energy goes:
 * onset by distance [J/m]: the onset energy of the particles within 1 mm, 1-3 mm and beyond
   3 mm of the nearest cracked particle (fixed lengths, so that a zone of physical width keeps
   its band under refinement and one of a few spacings moves towards the first);
+* flank: the uncracked particles within 1 mm of a crack, their number per cracked particle,
+  their median opening w / w_c and median history kappa / kappa0;
 * kappa_c / kappa0: the regularized critical strain (4.28) over the threshold, median over the
   particles that initiated.
 
@@ -63,6 +65,9 @@ def measure(h: float, overrides: dict) -> dict:
     rest = np.flatnonzero(~cracked & (r.dissipation > 0))
     far = cKDTree(x[cracked]).query(x[rest])[0] if cracked.any() and rest.size else np.zeros(rest.size)
     bands = [float(r.dissipation[rest][(far >= lo) & (far < hi)].sum()) for lo, hi in ONSET_BANDS]
+    flank = rest[far < ONSET_BANDS[0][1]]  # the uncracked particles beside the cracks
+    flank_w = float(np.median(r.opening[flank])) if flank.size else None
+    flank_kappa = float(np.median(r.kappa[flank] / model.kappa0[flank])) if flank.size else None
     started = np.flatnonzero(r.kappa > model.kappa0)  # the particles that initiated
     chords = dm.chord_lengths(model.geometry, started, r.normal[started])
     ratio = dm.critical_strain(material, chords, model.volume[started]) / model.kappa0[started]
@@ -72,7 +77,8 @@ def measure(h: float, overrides: dict) -> dict:
             "mid_plane_mm": 1e3 * float(np.ptp(x[mid, 0])) if mid.sum() > 1 else 0.0,
             "dissipated": float(r.history[-1, 1]), "crack": crack, "onset": float(r.history[-1, 1]) - crack,
             "kappa_c_over_kappa0": float(np.median(ratio)) if ratio.size else None,
-            "onset_by_distance": bands, "steps": r.steps, "wall_s": time.perf_counter() - t0}
+            "onset_by_distance": bands, "flank_per_cracked": flank.size / max(1, int(cracked.sum())),
+            "flank_opening": flank_w, "flank_kappa_over_kappa0": flank_kappa, "steps": r.steps, "wall_s": time.perf_counter() - t0}
 
 
 ROW = ("| {h:.1f} | {variant} | {branches} | {side_by_side} | {split} | {x_two} | {mid_plane_mm:.1f} | "
