@@ -87,3 +87,15 @@ def test_singular_system_is_reported_by_the_solver():
     a = sp.csr_matrix(np.array([[1.0, 1.0], [1.0, 1.0]]))
     with pytest.raises(SolverDiverged, match="singular"):
         solve(a, np.array([1.0, 0.0]))
+
+
+def test_a_jittered_grid_moves_only_its_interior_nodes_and_refuses_crossing_ones():
+    from rkfx.geometry.particles import jittered, structured
+
+    p, grid = jittered(5, amplitude=0.3, seed=1), structured(1.0, 1.0, 5, 5)
+    moved = np.abs(p.x - grid.x).max(axis=1)
+    on_edge = (np.abs(grid.x - 0.5) > 0.5 - 1e-12).any(axis=1)
+    assert p.num_nodes == 25 and not moved[on_edge].any() and 0 < moved.max() <= 0.3 * 0.25
+    assert len(p.boundary_nodes("left")) == 5
+    with pytest.raises(InputError, match="amplitude = 0.5"):
+        jittered(5, amplitude=0.5)

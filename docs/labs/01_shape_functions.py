@@ -47,7 +47,7 @@ import numpy as np  # noqa: E402
 
 from rkfx.approximation.kernel import cubic_spline_values  # noqa: E402
 from rkfx.approximation.shape_functions import evaluate, rk_approximation  # noqa: E402
-from rkfx.geometry.particles import from_points  # noqa: E402
+from rkfx.geometry.particles import jittered  # noqa: E402
 
 OUT = Path(os.environ.get("RKFX_LAB_OUT", Path.cwd() / "lab_output"))
 OUT.mkdir(parents=True, exist_ok=True)
@@ -77,21 +77,14 @@ plt.close(fig)
 # ## An irregular node set
 #
 # Meshfree methods do not need a mesh, but rkfx keeps a triangulation of the nodes for the
-# geometry and (in Lab 2) for the nodal integration cells. `from_points` Delaunay-triangulates
-# a node cloud inside a polygon and names the polygon's sides. We jitter the interior nodes
-# of an 11 x 11 grid on the unit square so that nothing is aligned by accident.
+# geometry and (in Lab 2) for the nodal integration cells. `jittered` moves the interior nodes
+# of an 11 x 11 grid on the unit square at random, by up to 0.3 spacings, so that nothing is
+# aligned by accident, and triangulates them (`from_points`: Delaunay inside a polygon whose
+# sides it names).
 
 # %%
-rng = np.random.default_rng(7)
 n_side = 11
-h = 1.0 / (n_side - 1)
-g = np.linspace(0.0, 1.0, n_side)
-X, Y = np.meshgrid(g, g)
-x = np.column_stack([X.ravel(), Y.ravel()])
-interior = (x > 1e-12).all(axis=1) & (x < 1 - 1e-12).all(axis=1)
-x[interior] += rng.uniform(-0.3 * h, 0.3 * h, size=(interior.sum(), 2))
-square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-p = from_points(x, square, names={"bottom": [0], "right": [1], "top": [2], "left": [3]})
+p = jittered(n_side, amplitude=0.3, seed=7)
 print(f"{p.num_nodes} nodes, mean spacing {p.spacing.mean():.4f}")
 
 # %% [markdown]

@@ -46,7 +46,7 @@ from rkfx.approximation.shape_functions import evaluate, rk_approximation  # noq
 from rkfx.assembly.boundary import boundary_quadrature  # noqa: E402
 from rkfx.conditions import Displacement, Traction  # noqa: E402
 from rkfx.geometry.nodal_domains import nodal_domains  # noqa: E402
-from rkfx.geometry.particles import from_points  # noqa: E402
+from rkfx.geometry.particles import jittered  # noqa: E402
 from rkfx.integration.quadrature import integration_rules  # noqa: E402
 from rkfx.materials.elasticity import ElasticMaterial  # noqa: E402
 from rkfx.models.elastostatics import solve_plane_strain  # noqa: E402
@@ -66,16 +66,8 @@ t_start = time.perf_counter()
 # of its subcells. They tile the domain exactly.
 
 # %%
-rng = np.random.default_rng(3)
 n_side = 9
-h = 1.0 / (n_side - 1)
-g = np.linspace(0.0, 1.0, n_side)
-X, Y = np.meshgrid(g, g)
-x = np.column_stack([X.ravel(), Y.ravel()])
-interior = (x > 1e-12).all(axis=1) & (x < 1 - 1e-12).all(axis=1)
-x[interior] += rng.uniform(-0.3 * h, 0.3 * h, size=(interior.sum(), 2))
-square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-p = from_points(x, square, names={"bottom": [0], "right": [1], "top": [2], "left": [3]})
+p = jittered(n_side, amplitude=0.3, seed=3)
 domains = nodal_domains(p)
 print(f"{p.num_nodes} nodes; the cells cover an area of {domains.area.sum():.15f}")
 assert abs(domains.area.sum() - 1.0) < 1e-13

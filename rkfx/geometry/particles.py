@@ -250,6 +250,23 @@ def geometric_spacing(length: float, n: int, ratio: float) -> np.ndarray:
     return np.r_[0.0, np.cumsum(steps)] * (length / steps.sum())
 
 
+def jittered(n: int, amplitude: float = 0.3, seed: int = 0) -> Particles:
+    """An ``n`` x ``n`` grid on the unit square with every interior node moved at random by up to
+    ``amplitude`` times the spacing in x and y (an irregular node set for patch tests and
+    reproducing conditions); boundary names bottom, right, top, left."""
+    if int(n) != n or n < 3:
+        raise InputError(f"n = {n!r}: a jittered grid needs an integer >= 3 nodes per side")
+    if not 0.0 <= amplitude < 0.5:
+        raise InputError(f"amplitude = {amplitude!r}: use 0 <= amplitude < 0.5 spacings (nodes must not cross)")
+    h = 1.0 / (int(n) - 1)
+    g = np.linspace(0.0, 1.0, int(n))
+    x = np.column_stack([np.tile(g, int(n)), np.repeat(g, int(n))])
+    inside = (x > 1e-12).all(axis=1) & (x < 1 - 1e-12).all(axis=1)
+    x[inside] += np.random.default_rng(seed).uniform(-amplitude * h, amplitude * h, size=(inside.sum(), 2))
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    return from_points(x, square, names={"bottom": [0], "right": [1], "top": [2], "left": [3]})
+
+
 def from_points(x: np.ndarray, polygon: np.ndarray, names: dict[str, list[int]] | None = None) -> Particles:
     """Particles from a node cloud inside a simple polygon (convex or not).
 
