@@ -17,7 +17,7 @@ import numpy as np
 import dolfinx_solver  # noqa: F401  (MPI first)
 from dolfinx import fem, io
 
-from rkfx.output.paraview import file_stem
+from rkfx.output.paraview import among, file_stem
 
 
 class FemSeries:
@@ -58,7 +58,7 @@ class FemSeries:
 
     def write(self, time: float, **functions: fem.Function) -> None:
         """Write the functions at ``time`` [s] (unless ``times`` leaves it out)."""
-        if self.times is not None and not np.any(np.isclose(time, self.times, rtol=1e-9, atol=0.0)):
+        if self.times is not None and not among(time, self.times):
             return
         out = []
         for key, f in functions.items():

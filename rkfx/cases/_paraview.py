@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from rkfx.models.damage_dynamics import Frames
-from rkfx.output.paraview import FieldSeries, MeshSeries, nodal_cells
+from rkfx.output.paraview import FieldSeries, MeshSeries, among, nodal_cells
 
 
 def write_biot(folder: Path, label: str, particles, sol, elastic, comm=None, times=None) -> FieldSeries:
@@ -20,7 +20,7 @@ def write_biot(folder: Path, label: str, particles, sol, elastic, comm=None, tim
         u, p, eps = sol.displacement(particles.x), sol.pressure(particles.x), sol.strain(particles.x)
         D = elastic.D()
         for k, t in enumerate(sol.times):
-            if times is not None and not np.any(np.isclose(t, times, rtol=1e-9, atol=0.0)):
+            if times is not None and not among(t, times):
                 continue
             tensor = eps[k] * [1.0, 1.0, 0.5]  # engineering gamma_xy to the tensor's eps_xy
             series.write(t, displacement=u[k], pressure=p[k], strain=tensor, effective_stress=eps[k] @ D.T)

@@ -37,6 +37,11 @@ def file_stem(label: str) -> str:
     return str(label).replace("=", "").replace(" ", "_").replace("/", "-")
 
 
+def among(time: float, times) -> bool:
+    """Whether ``time`` [s] is one of ``times`` (to a relative 1e-9): the output times a writer keeps."""
+    return bool(np.any(np.isclose(time, times, rtol=1e-9, atol=0.0)))
+
+
 def nodal_cells(p: Particles | NodalDomains) -> CellGeometry:
     """The nodal cells of ``p`` as quadrilateral subcells (median-dual cells of particles, or grid
     cells of domains that carry their subcell vertices) for ``FieldSeries(cells=...)``."""
