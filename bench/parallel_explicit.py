@@ -40,7 +40,7 @@ def main() -> None:
     if comm.size > 1:
         share_cores(comm)
     warm_up()
-    k.run(methods=("rkpm",), nodes=[40], unregularized_nodes=[], no_tracking_nodes=[], fem_nodes=[],
+    k.run(methods=("rkpm",), h=k.spacings([40]), unregularized_h=[], no_tracking_h=[], fem_h=[],
           t_end=5e-6)  # compile the step kernels
     prm = {name: spec.default for name, spec in k.PARAMS.items()}
     material = dm.DamageMaterial(prm["E"], prm["nu"], prm["ft"], prm["GF"], "strain")

@@ -168,3 +168,36 @@ def test_a_vertical_slit_ending_mid_face():
     p = graded(xs, ys)
     rk = rk_approximation(p.x, p.spacing, 2.0)
     assert np.abs(smoothed_gradients(p, rk, d, subcells=False).cell @ linear(p.x) - [2.0, -1.5]).max() < 1e-8
+
+
+@pytest.mark.parametrize("slits", [(), (SLIT,)])
+def test_cells_of_some_nodes_are_the_whole_builds(slits):
+    """grid_domains(nodes=): those nodes' cells and subcells entry for entry, every area and moment."""
+    whole = grid_domains(XC, YC, slits)
+    n = len(whole.area)
+    nodes = np.sort(np.random.default_rng(3).choice(n, n // 3, replace=False))
+    some = grid_domains(XC, YC, slits, nodes=nodes)
+    assert np.array_equal(some.area, whole.area) and np.array_equal(some.second_moment, whole.second_moment)
+    kept = np.isin(whole.subcell_node, nodes)
+    for name in ("subcell_node", "subcell_area", "subcell_centroid", "subcell_normal_length", "subcell_vertices"):
+        assert np.array_equal(getattr(some, name), getattr(whole, name)[kept]), name
+    assert np.array_equal(some.smoothing_points[some.subcell_point], whole.smoothing_points[whole.subcell_point[kept]])
+    assert len(some.smoothing_points) < len(whole.smoothing_points)
+    others = np.setdiff1d(np.arange(n), nodes)
+    assert np.all(np.diff(some.cell_ptr)[others] == 0)
+    for node in nodes:
+        a, b = slice(*some.cell_ptr[node:node + 2]), slice(*whole.cell_ptr[node:node + 2])
+        assert np.array_equal(some.smoothing_points[some.cell_point[a]], whole.smoothing_points[whole.cell_point[b]])
+        assert np.array_equal(some.cell_normal_length[a], whole.cell_normal_length[b])
+    assert np.array_equal(some.smoothing_points[some.boundary.point], whole.smoothing_points[whole.boundary.point])
+
+
+def test_rows_of_nodes_without_cells_are_refused_in_one_line():
+    from rkfx.assembly.smeared_strain import smeared_strain  # noqa: PLC0415
+
+    p = graded(XC, YC)
+    rk = rk_approximation(p.x, p.spacing, SUPPORT)
+    d = grid_domains(XC, YC, nodes=np.arange(10))
+    with pytest.raises(InputError, match=r"^\d+ of the particles whose rows are built \(first: 10\) have no cell.*nodes=") as e:
+        smeared_strain(p, rk, d, 1.0, points=np.arange(20))
+    assert "\n" not in str(e.value)

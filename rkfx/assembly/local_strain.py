@@ -19,16 +19,19 @@ One force evaluation, on local vectors (interleaved over the local nodes):
 
 Every sum runs over the same entries in the same order as the serial operator's, so the
 strains and forces equal the serial ones bit for bit, and so does a whole explicit run on
-any number of ranks. A rank slices these from an operator holding only the rows it reads
-(``StrainRecipe.share``: its particles' and those of the particles near its part), so no rank
-builds the whole operator.
+any number of ranks. From a ``StrainRecipe`` a rank builds only the rows it reads: its
+particles' rows, which become its local rows in place, and apart the rows of the other
+particles that touch its nodes (``StrainRecipe.near``); the transposed entries of its nodes
+are gathered from both in row order. No rank builds the whole operator or holds two copies
+of its rows.
 """
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from rkfx.approximation.sparse_rows import SparseRows
-from rkfx.assembly.smeared_strain import (SmearedStrain, cell_average, row_strains, subcell_load,
+from rkfx.assembly.smeared_strain import (SmearedStrain, StrainRecipe, cell_average, row_strains, subcell_load,
                                           transposed_force)
 from rkfx.errors import InputError
 from rkfx.parallel.halo import Halo, halo
@@ -159,7 +162,95 @@ def _numbering(owned: np.ndarray, others: np.ndarray, owner: np.ndarray, size: i
     return order, local_of
 
 
-def local_smeared_strain(op: SmearedStrain, part: np.ndarray, comm, extra_nodes=()) -> LocalSmearedStrain:
+@numba.njit(cache=True)
+def _mark_columns(indptr, indices, rows, mark):
+    for r in rows:
+        for e in range(indptr[r], indptr[r + 1]):
+            mark[indices[e]] = True
+
+
+@numba.njit(cache=True)
+def _copy_rows(indptr, indices, data, rows, column, out_indptr, out_indices, out_data):
+    k = 0
+    for i, r in enumerate(rows):
+        for e in range(indptr[r], indptr[r + 1]):
+            out_indices[k] = column[indices[e]]
+            out_data[k] = data[e]
+            k += 1
+        out_indptr[i + 1] = k
+
+
+@numba.njit(cache=True)
+def _copy_row(indptr, indices, data, r, column, fill, out_rows, out_data):
+    for e in range(indptr[r], indptr[r + 1]):
+        c = column[indices[e]]
+        if c >= 0:
+            out_rows[fill[c]] = r
+            out_data[fill[c]] = data[e]
+            fill[c] += 1
+
+
+@numba.njit(cache=True)
+def _copy_columns(indptr_a, indices_a, data_a, indptr_b, indices_b, data_b, column, fill, out_rows, out_data):
+    """The entries of two sets of rows numbered alike (each row's entries in one set) in the
+    columns with ``column`` >= 0, row by row, to ``out_*`` at the places ``fill`` of their columns."""
+    for r in range(len(indptr_a) - 1):
+        _copy_row(indptr_a, indices_a, data_a, r, column, fill, out_rows, out_data)
+        _copy_row(indptr_b, indices_b, data_b, r, column, fill, out_rows, out_data)
+
+
+def _sliced_rows(rows: SparseRows, at: np.ndarray, column: np.ndarray, num_cols: int) -> SparseRows:
+    """The rows ``at`` of ``rows``, each row's entries in their order, columns renumbered by
+    ``column`` (the global to local index)."""
+    indptr = np.zeros(len(at) + 1, np.int64)
+    size = int(np.diff(rows.indptr)[at].sum())
+    indices, data = np.empty(size, np.int32), np.empty((size, *rows.data.shape[1:]))
+    _copy_rows(rows.indptr, rows.indices, rows.data, at, column.astype(np.int32), indptr, indices, data)
+    return SparseRows(indptr, indices, data, num_cols)
+
+
+def _renumbered_rows(rows: SparseRows, at: np.ndarray, column: np.ndarray, num_cols: int) -> SparseRows:
+    """``_sliced_rows`` of rows that hold entries in the rows ``at`` alone: their own arrays,
+    the columns renumbered in place (``rows`` is spent)."""
+    counts = np.diff(rows.indptr)[at]
+    if counts.sum() != rows.indices.size:
+        raise InputError("rows outside the owned ones hold entries; build the owned rows alone "
+                         "(StrainRecipe.build(points=owned))")
+    indptr = np.zeros(len(at) + 1, np.int64)
+    np.cumsum(counts, out=indptr[1:])
+    indices = rows.indices
+    indices[:] = column.astype(np.int32)[indices]
+    return SparseRows(indptr, indices, rows.data, num_cols)
+
+
+def _owned_columns(sources: list[SparseRows], mine: np.ndarray, n: int):
+    """The entries of the rows ``sources`` (one numbering of rows, each row's entries in one of
+    them) in the columns ``mine`` (ascending), grouped by column, each column's in row order, as
+    ``transpose_rows`` groups them: their rows, data and the count per column of ``mine``."""
+    column = np.full(n, -1, np.int64)
+    column[mine] = np.arange(len(mine))
+    counts = sum(np.bincount(r.indices, minlength=n)[mine] for r in sources)
+    fill = np.zeros(len(mine), np.int64)
+    np.cumsum(counts[:-1], out=fill[1:])
+    size = int(counts.sum())
+    out_rows, out_data = np.empty(size, np.int64), np.empty((size, *sources[0].data.shape[1:]))
+    a = sources[0]
+    b = sources[1] if len(sources) > 1 else SparseRows(np.zeros_like(a.indptr), a.indices[:0], a.data[:0], a.num_cols)
+    _copy_columns(a.indptr, a.indices, a.data, b.indptr, b.indices, b.data, column, fill, out_rows, out_data)
+    return out_rows, out_data, counts
+
+
+def _terms(op: SmearedStrain):
+    """The rows a force sums over (MSCNI subcell rows, or the cell rows), their particles'
+    row pointer, the particle of each row, and the MSCNI terms."""
+    n = op.num_nodes
+    s = op.stabilization
+    if s is not None:
+        return s.rows, s.ptr, s.owner, s
+    return op.rows, np.arange(n + 1), np.arange(n), None
+
+
+def local_smeared_strain(op: SmearedStrain | StrainRecipe, part: np.ndarray, comm, extra_nodes=()) -> LocalSmearedStrain:
     """The share of ``comm.rank`` of ``op`` for the particle parts ``part`` (collective).
 
     Local nodes and rows are numbered owned first, then the ghosts by owner; the entries of
@@ -167,7 +258,10 @@ def local_smeared_strain(op: SmearedStrain, part: np.ndarray, comm, extra_nodes=
     fixes the order of the sums.
 
     Args:
-        op: The whole operator (points = particles).
+        op: The whole operator (points = particles), one holding at least the rows this rank
+            reads (``StrainRecipe.share``), or its recipe: then the rank builds the rows of its
+            particles, which become its local rows in place, and apart the rows of the other
+            particles that touch its nodes (``StrainRecipe.near``), so it never holds two copies.
         part: Rank of each particle, shape ``(n,)`` (e.g. ``rkfx.parallel.partition.rcb``).
         comm: The communicator (mpi4py).
         extra_nodes: Further nodes to keep as ghosts (e.g. every column of the constraints).
@@ -176,30 +270,30 @@ def local_smeared_strain(op: SmearedStrain, part: np.ndarray, comm, extra_nodes=
     n = op.num_nodes
     if part.shape != (n,):
         raise InputError(f"particle parts have shape {part.shape}; expected ({n},)")
-    s = op.stabilization
-    if s is not None:
-        rows, rows_t, ptr, row_point = s.rows, s.rows_t, s.ptr, s.owner
-    else:
-        rows, rows_t, ptr, row_point = op.rows, op.rows_t, np.arange(n + 1), np.arange(n)
     mine = np.flatnonzero(part == comm.rank)
+    spent = isinstance(op, StrainRecipe)  # rows built here for this rank alone
+    if spent:
+        others = _terms(op.build(np.setdiff1d(op.near(part, comm.rank), mine)))[0]
+        op = op.build(mine)
+        sources = [_terms(op)[0], others]
+        del others
+    else:
+        sources = None
+    rows, ptr, row_point, s = _terms(op)
     counts = ptr[mine + 1] - ptr[mine]
     orows = _ranges(ptr[mine], counts)
-    entries = _ranges(rows.indptr[orows], np.diff(rows.indptr)[orows])
-    cols = rows.indices[entries]
-    nodes, node_of = _numbering(mine, np.union1d(cols, np.asarray(extra_nodes, np.int64)), part, n)
-    indptr = np.zeros(len(orows) + 1, np.int64)
-    np.cumsum(np.diff(rows.indptr)[orows], out=indptr[1:])
-    local_rows = SparseRows(indptr, node_of[cols].astype(np.int32), np.ascontiguousarray(rows.data[entries]),
-                            len(nodes))
-    # The rows touching an owned node, through the transposed entries (each node's in row order).
-    t_counts = np.diff(rows_t.indptr)[mine]
-    t_entries = _ranges(rows_t.indptr[mine], t_counts)
-    trows = rows_t.indices[t_entries].astype(np.int64)
+    touched = np.zeros(n, bool)
+    _mark_columns(rows.indptr, rows.indices, orows, touched)
+    touched[np.asarray(extra_nodes, np.int64)] = True
+    nodes, node_of = _numbering(mine, np.flatnonzero(touched), part, n)
+    # The rows touching an owned node: the entries in owned columns, each node's in row order.
+    trows, t_data, t_counts = _owned_columns(sources or [rows], mine, n)
+    del sources
+    local_rows = (_renumbered_rows if spent else _sliced_rows)(rows, orows, node_of, len(nodes))
     lrows, row_of = _numbering(orows, trows, part[row_point], rows.num_rows)
     t_indptr = np.zeros(len(mine) + 1, np.int64)
     np.cumsum(t_counts, out=t_indptr[1:])
-    local_t = SparseRows(t_indptr, row_of[trows].astype(np.int32), np.ascontiguousarray(rows_t.data[t_entries]),
-                         len(lrows))
+    local_t = SparseRows(t_indptr, row_of[trows].astype(np.int32), t_data, len(lrows))
     row_weight = np.ones(len(lrows)) if s is not None else np.ascontiguousarray(op.volume[row_point[lrows]])
     point_ptr = np.zeros(len(mine) + 1, np.int64)
     np.cumsum(counts, out=point_ptr[1:])
@@ -209,4 +303,14 @@ def local_smeared_strain(op: SmearedStrain, part: np.ndarray, comm, extra_nodes=
         None if s is None else np.ascontiguousarray(s.fraction[orows]),
         None if s is None else np.ascontiguousarray(s.weight[orows]),
         np.ascontiguousarray(op.volume[mine]), local_t, row_weight, np.arange(len(orows)),
-        halo(nodes, part[nodes], comm), halo(lrows, part[row_point[lrows]], comm), stab, node_of)
+        halo(nodes, part[nodes], comm), halo(_row_names(lrows, ptr, row_point, comm), part[row_point[lrows]], comm),
+        stab, node_of)
+
+
+def _row_names(rows: np.ndarray, ptr: np.ndarray, row_point: np.ndarray, comm) -> np.ndarray:
+    """Names of ``rows`` that every rank gives them alike: particle times the most rows of any
+    particle, plus the row's place among its particle's (the row numbers themselves follow each
+    rank's build of the nodal domains, ``grid_domains(nodes=...)``). Collective."""
+    width = max(comm.allgather(int(np.diff(ptr).max(initial=1))))
+    point = row_point[rows]
+    return point * width + (rows - ptr[point])

@@ -163,7 +163,8 @@ class Stabilization:
     tau_C = (A_C / A_L) (V_L Sigma_L + sum_C' eps_p A_C' s_C') - eps_p A_C s_C.
 
     Attributes:
-        rows, rows_t: grad~N_I(x_hat_C) per subcell, grouped by particle, and transposed.
+        rows: grad~N_I(x_hat_C) per subcell, grouped by particle (``rows_t``, their transpose,
+            is built on first use).
         ptr: The subcells of particle L are rows ``ptr[L]:ptr[L+1]``, shape ``(n + 1,)``.
         owner: Particle L of each subcell, shape ``(num_subcells,)``.
         fraction: A_C / A_L, shape ``(num_subcells,)``.
@@ -171,11 +172,15 @@ class Stabilization:
     """
 
     rows: SparseRows
-    rows_t: SparseRows
     ptr: np.ndarray
     owner: np.ndarray
     fraction: np.ndarray
     weight: np.ndarray
+
+    @cached_property
+    def rows_t(self) -> SparseRows:
+        """The subcell rows grouped by column (``transpose_rows``)."""
+        return transpose_rows(self.rows)
 
     @cached_property
     def _unit(self) -> np.ndarray:
@@ -195,20 +200,25 @@ class SmearedStrain:
     fewer entries than the cell rows plus the difference rows.
 
     Attributes:
-        rows: grad~N_I(x_L) per node L, shape ``(n, n)`` with 2 components [1/m].
-        rows_t: The same entries grouped by I (the transpose), with components [1/m].
+        rows: grad~N_I(x_L) per node L, shape ``(n, n)`` with 2 components [1/m] (``rows_t``,
+            the same entries grouped by I, is built on first use: an MSCNI operator never
+            needs it).
         volume: V_L, shape ``(n,)`` [m^2] (per unit thickness).
         stabilization: MSCNI subcell terms, or ``None`` (plain SCNI).
     """
 
     rows: SparseRows
-    rows_t: SparseRows
     volume: np.ndarray
     stabilization: Stabilization | None = None
 
     @property
     def num_nodes(self) -> int:
         return len(self.volume)
+
+    @cached_property
+    def rows_t(self) -> SparseRows:
+        """The cell rows grouped by column (``transpose_rows``)."""
+        return transpose_rows(self.rows)
 
     def strain(self, d: np.ndarray) -> np.ndarray:
         """Smeared strains (eps_xx, eps_yy, gamma_xy) at the nodes, shape ``(n, 3)``, for
@@ -292,27 +302,37 @@ def smeared_strain(p: Particles, rk: RKApproximation, domains: NodalDomains | No
     check_eps_p(eps_p)
     domains = domains or nodal_domains(p)
     volume = np.ascontiguousarray(domains.area, dtype=np.float64)
+    if points is not None:
+        bare = np.asarray(points)[np.diff(domains.cell_ptr)[points] == 0]
+        if bare.size:
+            raise InputError(f"{bare.size} of the particles whose rows are built (first: {bare[0]}) have no cell "
+                             "in these nodal domains; build the domains with nodes= covering them")
     if eps_p == 0:
         if points is None:
             cell = smoothed_gradients(p, rk, domains, subcells=False).cell
         else:
             cell = _spread(smoothed_gradients(p, rk, domains, subcells=False, nodes=points).cell, points,
                            p.num_nodes)
-        return SmearedStrain(cell, transpose_rows(cell), volume)
+        op = SmearedStrain(cell, volume)
+        if points is None:
+            op.rows_t  # noqa: B018 - the transpose f_int reads, built at set-up
+        return op
     cell, sub, order = subcell_gradients(rk, domains, nodes=points)
     owner = np.ascontiguousarray(domains.subcell_node[order])
     ptr = np.zeros(p.num_nodes + 1, np.int64)
     np.cumsum(np.bincount(owner, minlength=p.num_nodes), out=ptr[1:])
     area = domains.subcell_area[order]
-    stab = Stabilization(sub, transpose_rows(sub), ptr, owner, np.ascontiguousarray(area / volume[owner]),
+    stab = Stabilization(sub, ptr, owner, np.ascontiguousarray(area / volume[owner]),
                          np.ascontiguousarray(eps_p * area, dtype=np.float64))
-    op = SmearedStrain(cell, transpose_rows(cell), volume, stab)
+    op = SmearedStrain(cell, volume, stab)
     probe = np.random.default_rng(0).standard_normal(2 * p.num_nodes)
     direct = row_strains(cell, probe)
     gap = np.abs(op.strain(probe) - direct).max() / max(np.abs(direct).max(), 1e-300)
     if not gap <= _PARTITION_TOL:
         raise InputError(f"the subcells do not partition the nodal cells (cell and subcell strains differ by "
                          f"{gap:.1e}); use eps_p=0 with these domains or rebuild them with nodal_domains/grid_domains")
+    if points is None:
+        stab.rows_t  # noqa: B018 - the transpose f_int reads, built at set-up
     return op
 
 
@@ -340,11 +360,14 @@ class StrainRecipe:
         """``smeared_strain`` of the recipe (only the rows of ``points`` if given)."""
         return smeared_strain(self.p, self.rk, self.domains, self.eps_p, points=points)
 
+    def near(self, part: np.ndarray, rank: int) -> np.ndarray:
+        """The particles whose rows rank ``rank`` of the partition ``part`` reads: its own and
+        every particle's whose rows touch one of its nodes (``near_part``)."""
+        return near_part(self.p.x, part, rank, 1.001 * (self.rk.support.max() + reach(self.p.x, self.domains)))
+
     def share(self, part: np.ndarray, rank: int) -> SmearedStrain:
-        """The rows that rank ``rank`` of the partition ``part`` reads: its particles' and every
-        particle's whose rows touch one of its nodes (``near_part``)."""
-        margin = 1.001 * (self.rk.support.max() + reach(self.p.x, self.domains))
-        return self.build(near_part(self.p.x, part, rank, margin))
+        """The rows of ``near``, each other row left empty in its place."""
+        return self.build(self.near(part, rank))
 
 
 def _spread(rows: SparseRows, at: np.ndarray, num_rows: int) -> SparseRows:

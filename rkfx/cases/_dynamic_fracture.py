@@ -26,11 +26,12 @@ import numpy as np
 from rkfx.fracture import damage as dm
 from rkfx.fracture.tracking import Tracking
 from rkfx.approximation.diffraction import Cracks, cracks
-from rkfx.assembly.smeared_strain import SmearedStrain, StrainRecipe, lumped_mass, stable_time_step
+from rkfx.assembly.smeared_strain import SmearedStrain, StrainRecipe, lumped_mass, near_part, stable_time_step
 from rkfx.models.damage_dynamics import DamageRun, run_damage
 from rkfx.geometry.grid_cells import grid_domains
 from rkfx.geometry.nodal_domains import NodalDomains
 from rkfx.geometry.particles import Particles, graded
+from rkfx.parallel.partition import rcb
 from rkfx.approximation.shape_functions import RKApproximation, evaluate, rk_approximation
 from rkfx.solvers.central_difference import Constraint
 from rkfx.cases import _paraview, _preflight
@@ -47,7 +48,8 @@ class Plate:
         xs, ys: Grid coordinates [m].
         p: Particles (node j * nx + i at (xs[i], ys[j])).
         rk: RK approximation with the cracks.
-        domains: Rectangular Voronoi cells.
+        domains: Rectangular Voronoi cells; on MPI ranks only those of the particles near the
+            rank's part (``whole_domains`` builds them all), with every area.
         op: Smeared strain operator B~ (4.31)-(4.33); on MPI ranks its recipe, from which each
             rank of ``simulate`` builds only the rows of its share.
         mass: Lumped mass per unknown [kg per unit thickness].
@@ -69,6 +71,12 @@ class Plate:
     def h(self) -> float:
         """Largest grid spacing [m]."""
         return float(max(np.diff(self.xs).max(), np.diff(self.ys).max()))
+
+    def whole_domains(self) -> NodalDomains:
+        """The cells of every particle (those of ``domains`` if it has them all)."""
+        if isinstance(self.op, SmearedStrain):
+            return self.domains
+        return grid_domains(self.xs, self.ys, list(self.cracks.segments))
 
 
 def memory_need(methods: Sequence[str], rkpm: dict[str, Sequence], fem: dict[str, Sequence],
@@ -97,13 +105,19 @@ def plate(xs: np.ndarray, ys: np.ndarray, slits: Sequence, tips: Sequence[tuple[
     cracks ``slits`` (free tips flagged by ``tips``), SCNI cells with the MSCNI terms of weight
     ``eps_p`` (0: plain SCNI), lumped mass and the CFL step. With an MPI ``comm`` of several
     ranks the operator is left as its recipe: each rank of ``simulate`` builds only the rows of
-    its share."""
+    its share, and the cells of only the particles those rows read."""
     p = graded(xs, ys)
     c = cracks([np.asarray(s, float) for s in slits], tips)
     rk = rk_approximation(p.x, p.spacing, support_factor, cracks=c)
-    domains = grid_domains(xs, ys, slits)
+    parallel = comm is not None and comm.size > 1
+    nodes = None
+    if parallel:  # the particles StrainRecipe.share will read: a cell's smoothing points lie within
+        # half its diagonal of its particle
+        reach = 0.5 * np.hypot(np.diff(xs).max(), np.diff(ys).max())
+        nodes = near_part(p.x, rcb(p.x, comm.size), comm.rank, 1.001 * (rk.support.max() + reach))
+    domains = grid_domains(xs, ys, slits, nodes=nodes)
     recipe = StrainRecipe(p, rk, domains, eps_p)
-    op = recipe if comm is not None and comm.size > 1 else recipe.build()
+    op = recipe if parallel else recipe.build()
     dt = stable_time_step(p.spacing, material.elastic, rho, courant)
     return Plate(np.asarray(xs, float), np.asarray(ys, float), p, rk, domains, op, lumped_mass(domains.area, rho),
                  dt, c)
@@ -124,7 +138,7 @@ def simulate(label: str, pl: Plate, model: dm.DamageModel, track: Tracking | Non
     with an MPI ``comm`` of several ranks, distributed over them); with ``vtk`` a folder, the
     fields through time are written there for ParaView (``_paraview.damage_frames``)."""
     frames = None if vtk is None else _paraview.damage_frames(
-        vtk, label, pl.p.x, _paraview.nodal_cells(pl.domains), evaluate(pl.rk, pl.p.x).matrix(), comm)
+        vtk, label, pl.p.x, _paraview.nodal_cells(pl.whole_domains()), evaluate(pl.rk, pl.p.x).matrix(), comm)
     bar = step_progress(label, int(np.ceil(t_end / pl.dt - 1e-9)))
     try:
         return run_damage(label, pl.op, pl.mass, pl.dt, model, track, constraints, t_end, external_force, samples,

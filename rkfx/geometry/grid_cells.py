@@ -22,6 +22,7 @@ along a slit by ~1e-9 relative to the field's gradient; no boundary segments are
 (their faces are traction-free).
 """
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 
@@ -55,7 +56,8 @@ def _refined(c: np.ndarray) -> np.ndarray:
     return r
 
 
-def grid_domains(xs: np.ndarray, ys: np.ndarray, slits: Sequence | None = ()) -> NodalDomains:
+def grid_domains(xs: np.ndarray, ys: np.ndarray, slits: Sequence | None = (),
+                 nodes: np.ndarray | None = None) -> NodalDomains:
     """Rectangular nodal domains of the grid ``xs`` x ``ys`` with quadrant subcells (vectorised).
 
     Args:
@@ -63,6 +65,10 @@ def grid_domains(xs: np.ndarray, ys: np.ndarray, slits: Sequence | None = ()) ->
             ``rkfx.geometry.particles.graded(xs, ys)``.
         slits: Axis-aligned segments ((x0, y0), (x1, y1)) [m] on cell faces: on a midline
             between two grid rows (or columns), from and to grid or mid-grid coordinates.
+        nodes: Node indices (e.g. a rank's particles and those near them) whose cells and
+            subcells alone are built, equal entry for entry to the whole build's; areas,
+            moments and the boundary stay whole, the other nodes get no cell segments, and the
+            smoothing points are only those the built cells and the boundary use.
 
     Returns:
         ``NodalDomains`` with ``subcell_vertices`` filled; ``boundary`` tags as ``graded``'s
@@ -97,6 +103,12 @@ def grid_domains(xs: np.ndarray, ys: np.ndarray, slits: Sequence | None = ()) ->
     sx, sy = _SX[None, :], _SY[None, :]
     keep = ((sx > 0) & (i < nx - 1) | (sx < 0) & (i > 0)) & ((sy > 0) & (j < ny - 1) | (sy < 0) & (j > 0))
     node, q = np.nonzero(keep)
+    whole_area, whole_moments = _integrals(node, q, i[:, 0], j[:, 0], xb, yb, n)
+    if nodes is not None:
+        mine = np.zeros(n, bool)
+        mine[np.asarray(nodes, np.int64)] = True
+        built = mine[node]
+        node, q = node[built], q[built]
     i, j, sx, sy = i[node, 0], j[node, 0], _SX[q], _SY[q]
     lx0, ly0, lx1, ly1 = 2 * i, 2 * j, 2 * i + sx, 2 * j + sy
     ax, ay = np.minimum(lx0, lx1), np.minimum(ly0, ly1)  # refined intervals spanned
@@ -124,20 +136,32 @@ def grid_domains(xs: np.ndarray, ys: np.ndarray, slits: Sequence | None = ()) ->
     outer[:, 3] = np.where(ccw, v_open, h_open)
     if slits:
         side_point, points = _split_slits(slits, xs, ys, xb, yb, points, side_point, verts[:, 0], num_v)
-    # Quadrant integrals relative to the node: (a, b) = far corner - node.
     a, b = xf - xn, yf - yn
-    area = np.abs(a * b)
-    moments = np.column_stack([a * a * area / 3, 0.25 * a * b * area, b * b * area / 3])
+    boundary = _boundary(xb, yb, kx, ky, nx, vseg, hseg)
+    if nodes is not None:  # keep the smoothing points in use, in their order
+        used = np.zeros(len(points), bool)
+        used[side_point] = used[boundary.point] = True
+        number = np.cumsum(used) - 1
+        points, side_point = points[used], number[side_point]
+        boundary = replace(boundary, point=number[boundary.point])
     cell_ptr = np.r_[0, np.cumsum(np.bincount(node, outer.sum(axis=1), n).astype(np.int64))]
     return NodalDomains(
-        area=np.bincount(node, area, n),
-        second_moment=np.column_stack([np.bincount(node, moments[:, c], n) for c in range(3)]),
-        subcell_node=node, subcell_area=area,
+        area=whole_area, second_moment=whole_moments,
+        subcell_node=node, subcell_area=np.abs(a * b),
         subcell_centroid=np.column_stack([xn + 0.5 * a, yn + 0.5 * b]),
         smoothing_points=points, subcell_point=side_point, subcell_normal_length=normal_length,
         cell_ptr=cell_ptr, cell_point=side_point[outer], cell_normal_length=normal_length[outer],
-        boundary=_boundary(xb, yb, kx, ky, nx, vseg, hseg),
-        subcell_vertices=verts)
+        boundary=boundary, subcell_vertices=verts)
+
+
+def _integrals(node, q, i, j, xb, yb, n):
+    """Area and second moments (about the node) of every node's cell, summed over its quadrants
+    ``(node, q)``: (a, b) = far corner - node."""
+    a = xb[2 * i[node] + _SX[q]] - xb[2 * i[node]]
+    b = yb[2 * j[node] + _SY[q]] - yb[2 * j[node]]
+    area = np.abs(a * b)
+    moments = (a * a * area / 3, 0.25 * a * b * area, b * b * area / 3)
+    return np.bincount(node, area, n), np.column_stack([np.bincount(node, m, n) for m in moments])
 
 
 def _boundary(xb, yb, kx, ky, nx, vseg, hseg) -> BoundarySegments:

@@ -25,7 +25,6 @@ and written once.
 import numpy as np
 
 from rkfx.assembly.local_strain import LocalSmearedStrain, local_smeared_strain
-from rkfx.assembly.smeared_strain import StrainRecipe
 from rkfx.fracture.damage import DamageModel, initiate
 from rkfx.fracture.tracking import Tracking
 from rkfx.models.damage_dynamics import DamageDynamics, DamageForce, damage_field
@@ -108,7 +107,7 @@ class RankDamage(DamageDynamics):
     Args:
         op, mass, model, track, dt, constraints, external_force: The whole problem, as for
             ``DamageDynamics`` (``op`` a ``SmearedStrain``, or its ``StrainRecipe``: then this
-            rank builds only the rows of its share, and keeps its slice of them).
+            rank builds only the rows it reads, ``local_smeared_strain``).
         part: Rank of each particle, shape ``(n,)``.
         comm: The communicator (mpi4py).
     """
@@ -116,9 +115,7 @@ class RankDamage(DamageDynamics):
     def __init__(self, op, mass, model: DamageModel, track: Tracking | None, dt: float, constraints, external_force,
                  part: np.ndarray, comm):
         columns = np.unique(np.concatenate([c.G.indices // 2 for c in constraints])) if constraints else []
-        rows = op.share(part, comm.rank) if isinstance(op, StrainRecipe) else op
-        local = local_smeared_strain(rows, part, comm, extra_nodes=columns)
-        del rows  # a rank's share of the rows: its slice is all it keeps
+        local = local_smeared_strain(op, part, comm, extra_nodes=columns)
         points, dofs = local.points, local.dofs
         self.op, self.damage_model = local, restricted(model, points)
         self.field = damage_field(self.damage_model, None, dt)
