@@ -19,3 +19,10 @@ def test_an_unknown_variant_is_refused_in_one_line(capsys, tmp_path):
     assert study.main(["--variants", "defaults,eps=3", "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "'eps=3'" in err[0] and "eps_p=0" in err[0]
+
+
+def test_the_residual_stiffness_variant_reaches_the_damage_model():
+    """residual is not a case parameter: the study sets it on the model (a cracked particle keeps
+    that share of its stiffness), which changes the run."""
+    plain, stiff = study.measure(1.6e-3, {}), study.measure(1.6e-3, study.VARIANTS["residual=1e-2"])
+    assert stiff["dissipated"] > 0 and stiff["dissipated"] != plain["dissipated"]

@@ -3,6 +3,7 @@ code, particle tracking (4.22), the history arrays and their checkpoints."""
 import numpy as np
 import pytest
 
+from rkfx.errors import InputError
 from rkfx.fracture import damage as dm
 from rkfx.fracture.tracking import tracking
 from rkfx.assembly.smeared_strain import elastic_force, smeared_strain
@@ -126,3 +127,31 @@ def test_failed_particles_lose_their_stabilization(square):
     field.allowed[:] = True
     assert np.allclose(force(d), 0.0, atol=1e-30)
     assert np.all(field.damage == 1.0)
+
+
+def test_a_residual_stiffness_keeps_that_share_of_a_failed_particles_force(square):
+    """residual eta: a failed particle (D = 1) carries eta C e, subcell terms included, so the
+    force of a fully failed square is eta times the elastic one; eta = 0 is the law (4.30)."""
+    from dataclasses import replace  # noqa: PLC0415
+
+    p, _, model = square
+    xs = ys = np.linspace(0.0, 1.0, 11)
+    op = smeared_strain(p, rk_approximation(p.x, p.spacing, 1.75), grid_domains(xs, ys), 1.0)
+    d = 1e-6 * np.random.default_rng(1).standard_normal(2 * p.num_nodes)
+    elastic = elastic_force(op, MATERIAL.elasticity())(d)
+    for eta in (0.0, 1e-2):
+        kept = replace(model, residual=eta)
+        field = damage_field(kept)
+        field.damaged[:] = field.allowed[:] = True
+        field.kappa[:], field.kappa_c[:] = 1.0, 0.5  # D = 1 everywhere
+        assert np.allclose(DamageForce(op, kept, field)(d), eta * elastic, rtol=1e-12, atol=1e-30)
+        assert np.all(field.damage == 1.0)  # the history is the law's
+
+
+@pytest.mark.parametrize("eta", [-0.1, 1.0, float("nan")])
+def test_a_residual_stiffness_outside_0_1_is_refused_in_one_line(square, eta):
+    from dataclasses import replace  # noqa: PLC0415
+
+    with pytest.raises(InputError, match="residual stiffness") as e:
+        replace(square[2], residual=eta)
+    assert "\n" not in str(e.value)

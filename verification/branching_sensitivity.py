@@ -26,6 +26,7 @@ import argparse
 import json
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -44,15 +45,21 @@ VARIANTS = {  # name: the parameters that differ from the case's defaults
     "tol=0.7": {"tol": 0.7},
     "courant=0.25": {"courant": 0.25},
     "symmetric candidates": {"forward": False},
+    "residual=1e-3": {"residual": 1e-3},
+    "residual=1e-2": {"residual": 1e-2},
 }
 
 
 def measure(h: float, overrides: dict) -> dict:
-    """One regularized run of the case at spacing ``h`` [m] with ``overrides``; its measurements."""
+    """One regularized run of the case at spacing ``h`` [m] with ``overrides`` (case parameters, and
+    ``residual``: the residual stiffness of the damage model); its measurements."""
+    overrides = dict(overrides)
+    residual = overrides.pop("residual", 0.0)
     prm = {k: p.default for k, p in cb.PARAMS.items()} | overrides
     material = dm.DamageMaterial(prm["E"], prm["nu"], prm["ft"], prm["GF"], prm["plane"])
     t0 = time.perf_counter()
     pl, track, model, f = cb.setup(h, material, prm)
+    model = replace(model, residual=residual)
     r = dyn.simulate("study", pl, model, track, [], prm["t_end"], external_force=lambda t: f)
     branches, split, counts = cb.branch_metrics(r.opening, pl.xs, pl.ys)
     columns = pl.xs[pl.xs > cb.A1]
@@ -86,12 +93,28 @@ ROW = ("| {h:.1f} | {variant} | {branches} | {side_by_side} | {split} | {x_two} 
        "{wall_s:.0f} |")
 
 
+def spacings(text: str, prog: str) -> list[float] | None:
+    """The spacings [m] of a ``--h`` list, or ``None`` after a one-line error naming it."""
+    try:
+        hs = [float(v) for v in text.split(",") if v]
+    except ValueError:
+        hs = []
+    if not hs or not all(np.isfinite(h) and h > 0 for h in hs):
+        print(f"{prog}: --h {text!r} is not a comma-separated list of positive spacings in m (e.g. 8e-4,4e-4)",
+              file=sys.stderr)
+        return None
+    return hs
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--h", default="4e-4,2e-4", help="spacings [m], comma-separated")
     ap.add_argument("--variants", default=",".join(VARIANTS), help="which variants, comma-separated")
     ap.add_argument("--out", type=Path, default=Path("results/branching_sensitivity"))
     args = ap.parse_args(argv)
+    hs = spacings(args.h, "branching_sensitivity")
+    if hs is None:
+        return 2
     names = [v for v in args.variants.split(",") if v]
     unknown = [v for v in names if v not in VARIANTS]
     if unknown:
@@ -104,7 +127,7 @@ def main(argv=None) -> int:
           "dissipated [J/m] | crack | onset | onset share | onset < 1 / 1-3 / > 3 mm from a crack | "
           "kappa_c/kappa0 | wall [s] |")
     print("|" + "---|" * 14)
-    for h in (float(v) for v in args.h.split(",")):
+    for h in hs:
         for name in names:
             m = measure(h, VARIANTS[name]) | {"variant": name}
             rows.append(m)

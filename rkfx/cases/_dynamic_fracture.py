@@ -27,7 +27,7 @@ from rkfx.fracture import damage as dm
 from rkfx.fracture.tracking import Tracking
 from rkfx.approximation.diffraction import Cracks, cracks
 from rkfx.assembly.smeared_strain import SmearedStrain, StrainRecipe, lumped_mass, near_part, stable_time_step
-from rkfx.models.damage_dynamics import DamageRun, run_damage
+from rkfx.models.damage_dynamics import DamageRun, Frames, run_damage
 from rkfx.geometry.grid_cells import grid_domains
 from rkfx.geometry.nodal_domains import NodalDomains
 from rkfx.geometry.particles import Particles, graded
@@ -133,12 +133,14 @@ def damage_model(pl: Plate, material: dm.DamageMaterial, regularized: bool = Tru
 def simulate(label: str, pl: Plate, model: dm.DamageModel, track: Tracking | None, constraints: Sequence[Constraint],
              t_end: float, external_force: Callable[[float], np.ndarray] | None = None, samples: int = 200,
              checkpoint_every: int = 0, work_dir: Path | None = None, resume: Path | None = None,
-             comm=None, vtk: Path | None = None) -> DamageRun:
+             comm=None, vtk: Path | None = None, frames: Frames | None = None) -> DamageRun:
     """The damage particle method on the plate to ``t_end`` (``rkfx.models.damage_dynamics.run_damage``;
     with an MPI ``comm`` of several ranks, distributed over them); with ``vtk`` a folder, the
-    fields through time are written there for ParaView (``_paraview.damage_frames``)."""
-    frames = None if vtk is None else _paraview.damage_frames(
-        vtk, label, pl.p.x, _paraview.nodal_cells(pl.whole_domains()), evaluate(pl.rk, pl.p.x).matrix(), comm)
+    fields through time are written there for ParaView (``_paraview.damage_frames``); else
+    ``frames`` receives them (e.g. for a study of the fields)."""
+    if vtk is not None:
+        frames = _paraview.damage_frames(vtk, label, pl.p.x, _paraview.nodal_cells(pl.whole_domains()),
+                                         evaluate(pl.rk, pl.p.x).matrix(), comm)
     bar = step_progress(label, int(np.ceil(t_end / pl.dt - 1e-9)))
     try:
         return run_damage(label, pl.op, pl.mass, pl.dt, model, track, constraints, t_end, external_force, samples,

@@ -363,6 +363,10 @@ class DamageModel:
             (4.28): a crack runs between two particles' cells and each dissipates G_F A_L / 2.
             2 for a crack band one element wide (Bazant and Oh): kappa_c = 2 G_F / (f_t h_e)
             with the band width h_e = V_L / A_L, so that one failed element dissipates G_F A_L.
+        residual: Residual stiffness eta of the explicit force (``rkfx.models.damage_dynamics``):
+            the stress is max(1 - D, eta) C e, so a cracked particle keeps the fraction eta of
+            its stiffness (0, the default: none, as in (4.30)). A study option: the history,
+            damage and dissipation are the law's; the energy balance counts the stress it carries.
     """
 
     material: DamageMaterial
@@ -371,6 +375,12 @@ class DamageModel:
     geometry: CellGeometry | None
     kappa_c: np.ndarray | None
     band_factor: float = 1.0
+    residual: float = 0.0
+
+    def __post_init__(self):
+        if not 0.0 <= self.residual < 1.0:
+            raise InputError(f"residual stiffness = {self.residual!r} must lie in [0, 1) (0: none; 1e-3-1e-2 "
+                             "keeps a cracked particle that share of its stiffness)")
 
     @property
     def num_points(self) -> int:

@@ -176,6 +176,7 @@ class DamageForce:
         self._effective = np.empty((n, 3))
         self._crossing = np.empty(n, np.bool_)
         self.stress = np.empty((n, 3))
+        self.residual = float(model.residual)
 
     def __call__(self, d: np.ndarray) -> np.ndarray:
         f, op = self.field, self.op
@@ -187,9 +188,14 @@ class DamageForce:
         self._initiate_all(np.flatnonzero(self._crossing))
         damage_kernel(self._eq, self._effective, f.allowed, f.damaged, self.kappa0, f.kappa_c, f.kappa, f.damage,
                       self.stress)
+        damage = f.damage
+        if self.residual > 0:  # max(1 - D, eta) C e
+            kept = np.maximum(1.0 - f.damage, self.residual)
+            np.multiply(self._effective, kept[:, None], out=self.stress)
+            damage = 1.0 - kept
         if stab is None:
             return op.force(self.stress)
-        _subcell_stress(diff, self.c, stab.owner, f.damage, diff)
+        _subcell_stress(diff, self.c, stab.owner, damage, diff)
         return op.force(self.stress, diff)
 
     def _initiate_all(self, new: np.ndarray) -> None:

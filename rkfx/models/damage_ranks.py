@@ -22,6 +22,8 @@ may differ in the last digits (sums in another order). Checkpoints are one file 
 (``rank<r>-of-<P>/``, resumable on the same number of ranks); finished results are gathered
 and written once.
 """
+from dataclasses import replace
+
 import numpy as np
 
 from rkfx.assembly.local_strain import LocalSmearedStrain, local_smeared_strain
@@ -56,8 +58,8 @@ def _summed(comm, values: np.ndarray) -> np.ndarray:
 def restricted(model: DamageModel, points: np.ndarray) -> DamageModel:
     """The data of ``points`` of ``model`` (the cell geometry stays whole: it is read by the
     global indices of initiating points)."""
-    return DamageModel(model.material, model.volume[points], model.kappa0[points], model.geometry,
-                       None if model.kappa_c is None else model.kappa_c[points], model.band_factor)
+    return replace(model, volume=model.volume[points], kappa0=model.kappa0[points],
+                   kappa_c=None if model.kappa_c is None else model.kappa_c[points])
 
 
 class RankDamageForce(DamageForce):
