@@ -45,7 +45,7 @@ class Tracking:
 
     Attributes:
         x: Particle positions, shape ``(n, 2)`` [m].
-        indptr, indices: The neighbour sets N_L as CSR (self excluded).
+        indptr, indices: The neighbour sets N_L as CSR (self excluded; indices int32).
         tol: Tolerance of (4.22), in (0, 1].
         seeds: Particles that may always initiate, shape ``(n,)`` bool.
         enabled: ``False`` lets every particle damage.
@@ -73,7 +73,7 @@ class Tracking:
         counts = self.indptr[nodes + 1] - self.indptr[nodes]
         rows = np.repeat(np.arange(len(nodes)), counts)
         cols = np.concatenate([self.indices[self.indptr[i]:self.indptr[i + 1]] for i in nodes]) \
-            if len(nodes) else np.empty(0, np.int64)
+            if len(nodes) else np.empty(0, self.indices.dtype)
         d = self.x[cols] - self.x[nodes[rows]]
         ok = np.abs(np.sum(normals[rows] * d, axis=1)) < self.tol * np.linalg.norm(d, axis=1)
         if self.forward and parents is not None:
@@ -123,4 +123,4 @@ def tracking(x: np.ndarray, spacing: np.ndarray, tol: float, seeds: np.ndarray |
     keep = idx != np.repeat(np.arange(n), np.diff(ptr))
     new_ptr = np.zeros(n + 1, np.int64)
     np.cumsum(np.add.reduceat(keep.astype(np.int64), ptr[:-1]) if n else [], out=new_ptr[1:])
-    return Tracking(x, new_ptr, idx[keep].astype(np.int64), float(tol), mask, bool(enabled), bool(forward))
+    return Tracking(x, new_ptr, idx[keep], float(tol), mask, bool(enabled), bool(forward))

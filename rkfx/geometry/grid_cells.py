@@ -86,10 +86,16 @@ def grid_domains(xs: np.ndarray, ys: np.ndarray, slits: Sequence | None = (),
     # Smoothing points: vertical segments V(l, b) on x = xb[l], y in [yb[b], yb[b+1]], then
     # horizontal segments H(l, a) on y = yb[l], x in [xb[a], xb[a+1]].
     num_v = len(xb) * ky
+    total = num_v + len(yb) * kx
     xmid, ymid = 0.5 * (xb[1:] + xb[:-1]), 0.5 * (yb[1:] + yb[:-1])
-    points = np.concatenate([
-        np.column_stack([np.repeat(xb, ky), np.tile(ymid, len(xb))]),
-        np.column_stack([np.tile(xmid, len(yb)), np.repeat(yb, kx)])])
+
+    def coordinates(ids):  # of the smoothing points ids (< total)
+        out = np.empty((len(ids), 2))
+        v = ids < num_v
+        out[v, 0], out[v, 1] = xb[ids[v] // ky], ymid[ids[v] % ky]
+        h = ids[~v] - num_v
+        out[~v, 0], out[~v, 1] = xmid[h % kx], yb[h // kx]
+        return out
 
     def vseg(l, b):
         return l * ky + b
@@ -103,7 +109,7 @@ def grid_domains(xs: np.ndarray, ys: np.ndarray, slits: Sequence | None = (),
     sx, sy = _SX[None, :], _SY[None, :]
     keep = ((sx > 0) & (i < nx - 1) | (sx < 0) & (i > 0)) & ((sy > 0) & (j < ny - 1) | (sy < 0) & (j > 0))
     node, q = np.nonzero(keep)
-    whole_area, whole_moments = _integrals(node, q, i[:, 0], j[:, 0], xb, yb, n)
+    whole_area, whole_moments = _integrals(keep, i[:, 0], j[:, 0], xb, yb)
     if nodes is not None:
         mine = np.zeros(n, bool)
         mine[np.asarray(nodes, np.int64)] = True
@@ -134,16 +140,30 @@ def grid_domains(xs: np.ndarray, ys: np.ndarray, slits: Sequence | None = (),
     outer = np.ones((len(node), 4), bool)
     outer[:, 0] = np.where(ccw, h_open, v_open)
     outer[:, 3] = np.where(ccw, v_open, h_open)
+    slit_points, shift = np.zeros(0, np.int64), np.zeros((0, 2))
     if slits:
-        side_point, points = _split_slits(slits, xs, ys, xb, yb, points, side_point, verts[:, 0], num_v)
+        side_point, slit_points, shift = _split_slits(slits, xs, ys, xb, yb, total, coordinates, side_point,
+                                                      verts[:, 0], num_v)
     a, b = xf - xn, yf - yn
     boundary = _boundary(xb, yb, kx, ky, nx, vseg, hseg)
-    if nodes is not None:  # keep the smoothing points in use, in their order
-        used = np.zeros(len(points), bool)
+    # The smoothing points: every one, or (nodes given) those in use, in their order; the
+    # points on slits moved off them to the low side, their copies (numbered from total) to the high.
+    used = np.ones(total + len(slit_points), bool)
+    if nodes is not None:
+        used[:] = False
         used[side_point] = used[boundary.point] = True
         number = np.cumsum(used) - 1
-        points, side_point = points[used], number[side_point]
-        boundary = replace(boundary, point=number[boundary.point])
+        side_point, boundary = number[side_point], replace(boundary, point=number[boundary.point])
+    ids = np.flatnonzero(used)
+    base = ids < total
+    points = np.empty((len(ids), 2))
+    points[base] = coordinates(ids[base])
+    copy = np.full(total, -1, np.int64)
+    copy[slit_points] = np.arange(len(slit_points))
+    low = np.flatnonzero(base)[copy[ids[base]] >= 0]
+    points[low] -= shift[copy[ids[low]]]
+    high = ids[~base] - total
+    points[~base] = coordinates(slit_points[high]) + shift[high]
     cell_ptr = np.r_[0, np.cumsum(np.bincount(node, outer.sum(axis=1), n).astype(np.int64))]
     return NodalDomains(
         area=whole_area, second_moment=whole_moments,
@@ -154,14 +174,21 @@ def grid_domains(xs: np.ndarray, ys: np.ndarray, slits: Sequence | None = (),
         boundary=boundary, subcell_vertices=verts)
 
 
-def _integrals(node, q, i, j, xb, yb, n):
-    """Area and second moments (about the node) of every node's cell, summed over its quadrants
-    ``(node, q)``: (a, b) = far corner - node."""
-    a = xb[2 * i[node] + _SX[q]] - xb[2 * i[node]]
-    b = yb[2 * j[node] + _SY[q]] - yb[2 * j[node]]
-    area = np.abs(a * b)
-    moments = (a * a * area / 3, 0.25 * a * b * area, b * b * area / 3)
-    return np.bincount(node, area, n), np.column_stack([np.bincount(node, m, n) for m in moments])
+def _integrals(keep, i, j, xb, yb):
+    """Area and second moments (about the node) of every node's cell: the sums over its kept
+    quadrants in their order, (a, b) = far corner - node."""
+    n = len(i)
+    area, moments = np.zeros(n), np.zeros((n, 3))
+    for q in range(4):
+        k = keep[:, q]
+        a = np.where(k, xb[np.clip(2 * i + _SX[q], 0, len(xb) - 1)] - xb[2 * i], 0.0)
+        b = np.where(k, yb[np.clip(2 * j + _SY[q], 0, len(yb) - 1)] - yb[2 * j], 0.0)
+        quadrant = np.abs(a * b)
+        area += quadrant
+        moments[:, 0] += a * a * quadrant / 3
+        moments[:, 1] += 0.25 * a * b * quadrant
+        moments[:, 2] += b * b * quadrant / 3
+    return area, moments
 
 
 def _boundary(xb, yb, kx, ky, nx, vseg, hseg) -> BoundarySegments:
@@ -191,15 +218,16 @@ def _boundary(xb, yb, kx, ky, nx, vseg, hseg) -> BoundarySegments:
         point=np.concatenate([p for *_, p in parts]).astype(np.int64))
 
 
-def _split_slits(slits, xs, ys, xb, yb, points, side_point, node_xy, num_v):
+def _split_slits(slits, xs, ys, xb, yb, total, coordinates, side_point, node_xy, num_v):
     """Give each cell its own smoothing point on the face segments lying on ``slits``: the
-    low-side cell keeps the point, moved down (or left); the high-side cell gets a copy moved up
-    (or right), each by ``SLIT_OFFSET`` times the grid interval across the slit."""
+    low-side cell keeps the point, to be moved down (or left); the high-side cell gets a copy
+    (numbered ``total`` + k), to be moved up (or right), each by ``SLIT_OFFSET`` times the grid
+    interval across the slit. Returns the sides' points, the points on slits and their shifts."""
     scale = max(np.ptp(xs), np.ptp(ys))
     tol = _TOL * scale
     kx, ky = len(xb) - 1, len(yb) - 1
-    on_slit = np.zeros(len(points), bool)
-    offset = np.zeros(len(points))
+    on_slit = np.zeros(total, bool)
+    offset = np.zeros(total)
     for k, slit in enumerate(slits):
         s = np.asarray(slit, dtype=np.float64)
         where = f"slit {k} {point_str(s[0])}-{point_str(s[1])}" if s.shape == (2, 2) else f"slit {k}"
@@ -232,15 +260,12 @@ def _split_slits(slits, xs, ys, xb, yb, points, side_point, node_xy, num_v):
     slit_points = np.flatnonzero(on_slit)
     normal = np.where((slit_points < num_v)[:, None], [1.0, 0.0], [0.0, 1.0])
     shift = offset[slit_points, None] * normal
-    copy = np.full(len(points), -1, np.int64)
-    copy[slit_points] = len(points) + np.arange(len(slit_points))
+    copy = np.full(total, -1, np.int64)
+    copy[slit_points] = total + np.arange(len(slit_points))
     # Sides on a slit whose node lies on the high side of it take the copy.
     sub, side = np.nonzero(on_slit[side_point])
     at = side_point[sub, side]
     axis = np.where(at < num_v, 0, 1)
-    high = node_xy[sub, axis] > points[at, axis]
+    high = node_xy[sub, axis] > coordinates(at)[np.arange(len(at)), axis]
     side_point[sub[high], side[high]] = copy[at[high]]
-    on_face = points[slit_points]
-    points = points.copy()
-    points[slit_points] = on_face - shift
-    return side_point, np.concatenate([points, on_face + shift])
+    return side_point, slit_points, shift
