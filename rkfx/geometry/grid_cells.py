@@ -154,7 +154,21 @@ def grid_domains(xs: np.ndarray, ys: np.ndarray, slits: Sequence | None = (),
         used[side_point] = used[boundary.point] = True
         number = np.cumsum(used) - 1
         side_point, boundary = number[side_point], replace(boundary, point=number[boundary.point])
-    ids = np.flatnonzero(used)
+    points = _placed_points(np.flatnonzero(used), total, coordinates, slit_points, shift)
+    cell_ptr = np.r_[0, np.cumsum(np.bincount(node, outer.sum(axis=1), n).astype(np.int64))]
+    return NodalDomains(
+        area=whole_area, second_moment=whole_moments,
+        subcell_node=node, subcell_area=np.abs(a * b),
+        subcell_centroid=np.column_stack([xn + 0.5 * a, yn + 0.5 * b]),
+        smoothing_points=points, subcell_point=side_point, subcell_normal_length=normal_length,
+        cell_ptr=cell_ptr, cell_point=side_point[outer], cell_normal_length=normal_length[outer],
+        boundary=boundary, subcell_vertices=verts)
+
+
+def _placed_points(ids, total, coordinates, slit_points, shift):
+    """The coordinates of the smoothing points ``ids`` (ascending): those below ``total`` at
+    ``coordinates``, the ones on slits moved by ``-shift``, and copy k (id ``total`` + k) at
+    slit point k moved by ``+shift``."""
     base = ids < total
     points = np.empty((len(ids), 2))
     points[base] = coordinates(ids[base])
@@ -164,14 +178,7 @@ def grid_domains(xs: np.ndarray, ys: np.ndarray, slits: Sequence | None = (),
     points[low] -= shift[copy[ids[low]]]
     high = ids[~base] - total
     points[~base] = coordinates(slit_points[high]) + shift[high]
-    cell_ptr = np.r_[0, np.cumsum(np.bincount(node, outer.sum(axis=1), n).astype(np.int64))]
-    return NodalDomains(
-        area=whole_area, second_moment=whole_moments,
-        subcell_node=node, subcell_area=np.abs(a * b),
-        subcell_centroid=np.column_stack([xn + 0.5 * a, yn + 0.5 * b]),
-        smoothing_points=points, subcell_point=side_point, subcell_normal_length=normal_length,
-        cell_ptr=cell_ptr, cell_point=side_point[outer], cell_normal_length=normal_length[outer],
-        boundary=boundary, subcell_vertices=verts)
+    return points
 
 
 def _integrals(keep, i, j, xb, yb):
