@@ -93,6 +93,12 @@ ROW = ("| {h:.1f} | {variant} | {branches} | {side_by_side} | {split} | {x_two} 
        "{wall_s:.0f} |")
 
 
+def print_header(columns: list[str]) -> None:
+    """The head of a markdown table of ``columns`` (the study's rows follow as they finish)."""
+    print("| " + " | ".join(columns) + " |")
+    print("|" + "---|" * len(columns))
+
+
 def spacings(text: str, prog: str) -> list[float] | None:
     """The spacings [m] of a ``--h`` list, or ``None`` after a one-line error naming it."""
     try:
@@ -123,10 +129,10 @@ def main(argv=None) -> int:
         return 2
     args.out.mkdir(parents=True, exist_ok=True)
     rows = []
-    print("| h [mm] | variant | branches | side by side | split x [mm] | pair to x [mm] | mid-plane [mm] | "
-          "dissipated [J/m] | crack | onset | onset share | onset < 1 / 1-3 / > 3 mm from a crack | "
-          "kappa_c/kappa0 | wall [s] |")
-    print("|" + "---|" * 14)
+    print_header([
+        "h [mm]", "variant", "branches", "side by side", "split x [mm]", "pair to x [mm]", "mid-plane [mm]",
+        "dissipated [J/m]", "crack", "onset", "onset share", "onset < 1 / 1-3 / > 3 mm from a crack",
+        "kappa_c/kappa0", "wall [s]"])
     for h in hs:
         for name in names:
             m = measure(h, VARIANTS[name]) | {"variant": name}

@@ -35,7 +35,7 @@ from rkfx.cases import _dynamic_fracture as dyn
 from rkfx.cases import crack_branching as cb
 from rkfx.fracture import damage as dm
 from rkfx.models.damage_dynamics import Frames
-from verification.branching_sensitivity import spacings
+from verification.branching_sensitivity import print_header, spacings
 
 FRAMES = 40
 DAMAGED = 0.05  # damage from which a particle counts as damaged
@@ -184,10 +184,10 @@ def main(argv=None) -> int:
         return 2
     args.out.mkdir(parents=True, exist_ok=True)
     runs = []
-    print("| h [mm] | frames | v / c_R single | v / c_R after split | hoop 45-75 / 0-15 deg at 1-2, 2-4 mm | "
-          "mean peak angle at 1-2, 2-4 mm [deg] | damaged at 1-2, 2-4 mm | sigma_yy / f_t at 1, 2, 4 mm | "
-          "D at 1, 2, 4 mm | tips at the end [mm] | split [mm] | branches | wall [s] |")
-    print("|" + "---|" * 13)
+    print_header([
+        "h [mm]", "frames", "v / c_R single", "v / c_R after split", "hoop 45-75 / 0-15 deg at 1-2, 2-4 mm",
+        "mean peak angle at 1-2, 2-4 mm [deg]", "damaged at 1-2, 2-4 mm", "sigma_yy / f_t at 1, 2, 4 mm",
+        "D at 1, 2, 4 mm", "tips at the end [mm]", "split [mm]", "branches", "wall [s]"])
     for h in hs:
         m = measure(h)
         runs.append(m)
