@@ -21,6 +21,11 @@ from rkfx.errors import InputError, SolverError
 SOLVERS = ("mumps", "gmres-ilu", "cg-gamg")
 
 
+# PETSc's KSPConvergedReason codes by name (e.g. 2: CONVERGED_RTOL).
+_REASONS = {code: name for name, code in vars(PETSc.KSP.ConvergedReason).items()
+            if isinstance(code, int) and not name.startswith("_")}
+
+
 class SolverDiverged(SolverError):
     """A PETSc linear solve did not converge."""
 
@@ -173,6 +178,8 @@ class LinearSolver:
         self.residual = self.mat.createVecLeft()
         self._norm = self.mat.norm(PETSc.NormType.NORM_INFINITY)
         self._warned = False
+        self.iterations = 0  # Krylov iterations of the last solve (1 for a direct solve)
+        self.reason = ""  # PETSc's name of why the last solve stopped
 
     def solve(self, b: np.ndarray, whole: bool = True) -> np.ndarray:
         """The whole solution on every rank (``b``: the whole right-hand side, or this rank's
@@ -188,6 +195,8 @@ class LinearSolver:
                                  "check that essential boundary conditions remove all rigid-body modes") from None
         null_pivots = self.ksp.getPC().getFactorMatrix().getMumpsInfog(28) if self.solver == "mumps" else 0
         reason = self.ksp.getConvergedReason()
+        self.iterations = max(self.ksp.getIterationNumber(), 1 if self.solver == "mumps" else 0)
+        self.reason = _REASONS.get(reason, str(reason))
         if reason < 0:
             raise SolverDiverged(f"PETSc solver {self.solver!r} diverged (KSPConvergedReason {reason}) after "
                                  f"{self.ksp.getIterationNumber()} iterations; try solver='mumps' or check the "

@@ -35,12 +35,15 @@ class ElasticSolution:
         coefficients: Nodal coefficients d_I (not nodal values), shape ``(num_nodes, 2)`` [m].
         n_dofs: Number of displacement unknowns.
         timings: Wall times of the stages [s].
+        linear: The linear solve: ``solver``, its ``iterations`` (1 for a direct solve) and
+            PETSc's ``reason`` for stopping.
     """
 
     rk: RKApproximation
     coefficients: np.ndarray
     n_dofs: int
     timings: dict[str, float] = field(default_factory=dict)
+    linear: dict = field(default_factory=dict)
 
     def displacement(self, points: np.ndarray) -> np.ndarray:
         """u^h at points, shape ``(m, 2)`` [m]."""
@@ -91,9 +94,10 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, conditions: Sequ
     rk = rk_approximation(p.x, p.spacing, support_factor, order)
     terms = dict(material=material, displacements=displacements, tractions=tractions, body_force=body_force,
                  rule=rule, bc_method=bc_method, nitsche_penalty=nitsche_penalty)
+    linear = {"solver": solver}
     if distributed:
-        coefficients = _solve_by_owned_rows(p, rk, terms, comm, solver, times, t0)
-        return ElasticSolution(rk, coefficients, 2 * p.num_nodes, times)
+        coefficients = _solve_by_owned_rows(p, rk, terms, comm, solver, times, t0, linear)
+        return ElasticSolution(rk, coefficients, 2 * p.num_nodes, times, linear)
     domains = nodal_domains(p)
     k, f, g, gv = elastic_terms(p, rk, domains, **terms)
     _check_rigid_modes(p, g)
@@ -109,9 +113,16 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, conditions: Sequ
     ls = linear_solver(system, comm, solver, coordinates=p.x if gamg else None)
     del k, system  # PETSc holds its own copy
     x = ls.solve(rhs)
+    linear.update(_statistics(ls))
     ls.destroy()
     times["solve"] = time.perf_counter() - t0
-    return ElasticSolution(rk, x[:2 * p.num_nodes].reshape(-1, 2), 2 * p.num_nodes, times)
+    return ElasticSolution(rk, x[:2 * p.num_nodes].reshape(-1, 2), 2 * p.num_nodes, times, linear)
+
+
+def _statistics(ls) -> dict:
+    """Iterations and stopping reason of a linear solver's last solve (SciPy's LU: one, direct)."""
+    ls = getattr(ls, "_ls", ls)  # a distributed system's PETSc solver
+    return {"iterations": getattr(ls, "iterations", 1), "reason": getattr(ls, "reason", "direct")}
 
 
 def elastic_terms(p: Particles, rk: RKApproximation, domains: NodalDomains, material: ElasticMaterial,
@@ -143,7 +154,7 @@ def elastic_terms(p: Particles, rk: RKApproximation, domains: NodalDomains, mate
 
 
 def _solve_by_owned_rows(p: Particles, rk: RKApproximation, terms: dict, comm, solver: str, times: dict,
-                         t0: float) -> np.ndarray:
+                         t0: float, linear: dict) -> np.ndarray:
     """The coefficients, shape ``(n, 2)``, on every rank, from a system assembled by owned rows.
 
     The nodes are split by RCB (``rkfx.parallel.partition``); each rank builds the nodal
@@ -152,7 +163,8 @@ def _solve_by_owned_rows(p: Particles, rk: RKApproximation, terms: dict, comm, s
     each rank's unknowns are contiguous (its nodes' displacements, then the multipliers of the
     collocation rows at its nodes), sends the rows owned elsewhere to their owners
     (``rkfx.parallel.rows``) and hands its block of rows to a preallocated PETSc matrix.
-    ``times`` gets the stages' wall times, assembly counted from ``t0``.
+    ``times`` gets the stages' wall times, assembly counted from ``t0``; ``linear`` the
+    solve's iterations and stopping reason.
     """
     rank, size = (0, 1) if comm is None else (comm.rank, comm.size)
     part = rcb(p.x, size)
@@ -185,6 +197,7 @@ def _solve_by_owned_rows(p: Particles, rk: RKApproximation, terms: dict, comm, s
     ls = linear_solver(block, comm, solver, owned_rows=True, coordinates=p.x[owned] if gamg else None)
     del block  # PETSc holds its own copy
     x = ls.solve(b)
+    linear.update(_statistics(ls))
     ls.destroy()
     times["solve"] = time.perf_counter() - t0
     return x[unknown[:2 * p.num_nodes]].reshape(-1, 2)
