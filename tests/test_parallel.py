@@ -149,7 +149,7 @@ def test_gamg_with_rigid_body_modes_gives_the_direct_solution():
     for distributed in (False, True):
         b = solve_plane_strain(p, MATERIAL, bcs, body_force=FIELD.body_force, solver="cg-gamg",
                                distributed=distributed)
-        assert np.abs(a.coefficients - b.coefficients).max() <= 1e-9 * np.abs(a.coefficients).max()
+        assert np.abs(a.coefficients - b.coefficients).max() <= 1e-7 * np.abs(a.coefficients).max()
     k = sp.identity(6, format="csr")
     with pytest.raises(InputError, match="coordinates of 2 nodes for 6 rows"):
         LinearSolver(k, solver="cg-gamg", coordinates=np.zeros((2, 2)))

@@ -2,6 +2,7 @@
 import numpy as np
 import pytest
 
+from rkfx.errors import InputError
 from rkfx.integration.norms import relative_errors
 from rkfx.models.elastostatics import solve_plane_strain
 from verification.timoshenko_beam import TimoshenkoBeam
@@ -47,3 +48,26 @@ def test_mscni_converges_on_the_beam():
     rate = lambda e: np.log(np.array(e[:-1]) / e[1:]) / np.log(np.array(h[:-1]) / h[1:])  # noqa: E731
     print(f"\nbeam L2 {np.round(l2, 6)} rates {np.round(rate(l2), 2)}; H1 {np.round(h1, 5)} rates {np.round(rate(h1), 2)}")
     assert np.all(rate(l2) >= 1.8) and np.all(rate(h1) >= 0.9)
+
+
+def test_auto_solver_switches_to_cg_gamg_above_the_direct_limit():
+    """solver="auto": MUMPS on a small beam, CG + GAMG (rigid-body modes, GAMG_THRESHOLD) above
+    AUTO_DIRECT_MAX_DOFS, in a few iterations and with MUMPS's displacements to the solver's
+    tolerance; the transformation method's saddle point stays direct; a bad name is refused."""
+    pytest.importorskip("petsc4py")
+    from rkfx.models.elastostatics import AUTO_DIRECT_MAX_DOFS, choose_solver  # noqa: PLC0415
+
+    beam = TimoshenkoBeam()
+    small = solve_plane_strain(beam.nodes(33, 9), beam.material(), beam.conditions())
+    assert small.linear["solver"] == "mumps" and small.n_dofs <= AUTO_DIRECT_MAX_DOFS
+    p = beam.nodes(161, 41)
+    auto = solve_plane_strain(p, beam.material(), beam.conditions())
+    direct = solve_plane_strain(p, beam.material(), beam.conditions(), solver="mumps")
+    assert auto.n_dofs > AUTO_DIRECT_MAX_DOFS and auto.linear["solver"] == "cg-gamg"
+    assert auto.linear["reason"] == "CONVERGED_RTOL" and 3 <= auto.linear["iterations"] <= 20
+    scale = np.abs(direct.coefficients).max()
+    assert np.abs(auto.coefficients - direct.coefficients).max() <= 1e-6 * scale
+    assert choose_solver("auto", 10**6, "transformation", "mscni") == "mumps"
+    assert choose_solver("auto", 10**6, "nitsche", "dni") == "mumps"
+    with pytest.raises(InputError, match="unknown linear solver 'amg'"):
+        solve_plane_strain(p, beam.material(), beam.conditions(), solver="amg")

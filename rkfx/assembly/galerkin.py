@@ -6,7 +6,9 @@ and most of the assembly's time. Here each node I owns its two rows of K: one pa
 points q whose rows hold I (the transposed entries, in point order) counts the distinct
 nodes J they couple I to, a second pass adds the 2 x 2 blocks B_I(q)^T w_q D_q B_J(q) in
 place. Rows are independent, so they run in parallel, and every entry is summed in the same
-order (points ascending, then the entries of each point's row) on any number of threads.
+order (points ascending, then the entries of each point's row) on any number of threads. The
+columns of each row come out sorted, and the transposed entries come from a counting sort:
+no sort of the whole entry list, no sort of K afterwards.
 
 B(g) of a gradient g = (g_x, g_y) is the Voigt strain matrix [[g_x, 0], [0, g_y], [g_y, g_x]].
 """
@@ -30,6 +32,25 @@ def _stiffness(ptr, idx, grad, point_of, t_ptr, t_entry, weight, d, per_point, n
             k = 0
             width = node_ptr[i + 1] - node_ptr[i] if fill else 0
             first = 4 * node_ptr[i]
+            if fill:  # the row's columns, ascending: slot[J] = rank of J among them
+                cols = np.empty(width, np.int64)
+                for e_i in range(t_ptr[i], t_ptr[i + 1]):
+                    q = point_of[t_entry[e_i]]
+                    for e in range(ptr[q], ptr[q + 1]):
+                        j = idx[e]
+                        if stamp[j] != i:
+                            stamp[j] = i
+                            cols[k] = j
+                            k += 1
+                cols.sort()
+                for s in range(width):
+                    j = cols[s]
+                    slot[j] = s
+                    for a in range(2):
+                        for b in range(2):
+                            pos = first + 2 * a * width + 2 * s + b
+                            out_idx[pos] = 2 * j + b
+                            out_data[pos] = 0.0
             for e_i in range(t_ptr[i], t_ptr[i + 1]):
                 p = t_entry[e_i]
                 q = point_of[p]
@@ -42,17 +63,11 @@ def _stiffness(ptr, idx, grad, point_of, t_ptr, t_entry, weight, d, per_point, n
                         t[1, s] = w * (gy * m[1, s] + gx * m[2, s])
                 for e in range(ptr[q], ptr[q + 1]):
                     j = idx[e]
-                    if stamp[j] != i:
-                        stamp[j] = i
-                        slot[j] = k
-                        if fill:
-                            for a in range(2):
-                                for b in range(2):
-                                    pos = first + 2 * a * width + 2 * k + b
-                                    out_idx[pos] = 2 * j + b
-                                    out_data[pos] = 0.0
-                        k += 1
-                    if fill:
+                    if not fill:
+                        if stamp[j] != i:
+                            stamp[j] = i
+                            k += 1
+                    else:
                         hx, hy = grad[e, 0], grad[e, 1]
                         base = first + 2 * slot[j]
                         for a in range(2):
@@ -77,9 +92,9 @@ def elastic_stiffness(rows: SparseRows, weights: np.ndarray, d: np.ndarray) -> s
     d = d if per_point else d.reshape(1, 3, 3)
     idx = np.ascontiguousarray(rows.indices)
     point_of = np.repeat(np.arange(m, dtype=np.int64), np.diff(rows.indptr))
-    t_entry = np.argsort(idx, kind="stable").astype(np.int64)  # each node's entries, points ascending
     t_ptr = np.zeros(n + 1, np.int64)
     np.cumsum(np.bincount(idx, minlength=n), out=t_ptr[1:])
+    t_entry = _transposed_entries(idx, t_ptr)
     args = (rows.indptr, idx, np.ascontiguousarray(rows.data, dtype=np.float64), point_of, t_ptr, t_entry,
             np.ascontiguousarray(weights, dtype=np.float64), d, per_point, n,
             work_items(n))
@@ -94,5 +109,17 @@ def elastic_stiffness(rows: SparseRows, weights: np.ndarray, d: np.ndarray) -> s
     indptr[1::2] = 4 * node_ptr[:-1] + 2 * np.diff(node_ptr)
     indptr[-1] = 4 * node_ptr[-1]
     k = sp.csr_matrix((out_data, out_idx, indptr), shape=(2 * n, 2 * n))
-    k.sort_indices()
+    k.has_sorted_indices = True
     return k
+
+
+@numba.njit(cache=True)
+def _transposed_entries(idx, t_ptr):
+    """The entries e of each column idx[e], in order of e (a stable counting sort): the entries
+    of node I are ``out[t_ptr[I]:t_ptr[I + 1]]``."""
+    cursor = t_ptr[:-1].copy()
+    out = np.empty(len(idx), np.int64)
+    for e in range(len(idx)):
+        out[cursor[idx[e]]] = e
+        cursor[idx[e]] += 1
+    return out

@@ -26,6 +26,27 @@ from rkfx.parallel.rows import owned_block, owned_entries, renumbered
 from rkfx.approximation.shape_functions import RKApproximation, evaluate, rk_approximation
 
 
+# solver="auto" solves directly up to this many unknowns and by CG + GAMG above, for a
+# symmetric positive definite system (Nitsche's method and a stable rule). On Timoshenko's beam
+# (bench/beam_scale.py, MSCNI) MUMPS and CG + GAMG take 0.06 s each at 2.2k unknowns, 0.25 s
+# and 0.14 s at 8.5k, 1.2 s and 0.52 s at 33k, 10.8 s and 2.2 s at 132k: below the switch both
+# are fast and the direct solve is the robust one; above it the fill of LU costs time and memory.
+AUTO_DIRECT_MAX_DOFS = 10_000
+SOLVER_CHOICES = ("auto", "mumps", "gmres-ilu", "cg-gamg")
+
+
+def choose_solver(solver: str, n_dofs: int, bc_method: str, rule: str) -> str:
+    """The linear solver ``solver="auto"`` stands for (see ``AUTO_DIRECT_MAX_DOFS``); any other
+    choice is returned as it is. The transformation method's multipliers make a saddle point
+    and direct nodal integration a nearly singular matrix: both are solved directly."""
+    if solver not in SOLVER_CHOICES:
+        raise InputError(f"unknown linear solver {solver!r}; choose one of {', '.join(SOLVER_CHOICES)}")
+    if solver != "auto":
+        return solver
+    spd = bc_method == "nitsche" and rule != "dni"
+    return "cg-gamg" if spd and n_dofs > AUTO_DIRECT_MAX_DOFS else "mumps"
+
+
 @dataclass(frozen=True)
 class ElasticSolution:
     """RK coefficients of the displacement and what is needed to evaluate it.
@@ -59,7 +80,7 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, conditions: Sequ
                        *, body_force: Callable[[np.ndarray], np.ndarray] | None = None,
                        rule: str = "mscni", bc_method: str = "nitsche", support_factor: float = 1.5,
                        order: int = 1, nitsche_penalty: float = 100.0, comm=None,
-                       solver: str = "mumps", distributed: bool | None = None) -> ElasticSolution:
+                       solver: str = "auto", distributed: bool | None = None) -> ElasticSolution:
     """Solve plane-strain elasticity on ``p``.
 
     Args:
@@ -75,7 +96,9 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, conditions: Sequ
         support_factor, order: RK support a_I = c h_I and basis degree.
         nitsche_penalty: Dimensionless Nitsche parameter.
         comm: MPI communicator for the PETSc solve (default COMM_WORLD).
-        solver: ``mumps`` | ``gmres-ilu`` | ``cg-gamg``.
+        solver: ``auto`` (MUMPS up to ``AUTO_DIRECT_MAX_DOFS`` unknowns, CG + GAMG with the
+            rigid-body modes above, for Nitsche's method and a stable rule) | ``mumps`` |
+            ``gmres-ilu`` | ``cg-gamg``. The solve's iterations and reason: ``.linear``.
         distributed: Assemble by owned rows (``_solve_by_owned_rows``): each rank integrates
             over the cells of its part of an RCB partition only. ``None`` (default): when
             ``comm`` has more than one rank and the rule is nodal (``scni``, ``mscni``); the
@@ -89,6 +112,7 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, conditions: Sequ
     elif distributed and rule not in NODAL_RULES:
         raise InputError(f"distributed=True needs a nodal rule ({', '.join(NODAL_RULES)}), not {rule!r}; "
                          "choose one, or distributed=False")
+    solver = choose_solver(solver, 2 * p.num_nodes, bc_method, rule)
     times = {}
     t0 = time.perf_counter()
     rk = rk_approximation(p.x, p.spacing, support_factor, order)
