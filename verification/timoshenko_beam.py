@@ -52,12 +52,15 @@ class TimoshenkoBeam:
 
     def displacement(self, x: np.ndarray) -> np.ndarray:
         """u(x), shape ``(m, 2)`` [m]."""
+        return np.column_stack(self.displacement_xy(x[:, 0], x[:, 1]))
+
+    def displacement_xy(self, X, Y) -> tuple:
+        """(u_x, u_y) at coordinates X, Y: arrays, or UFL expressions for a FEM error norm."""
         e, nu = self._moduli()
         L, D, P, c = self.L, self.D, self.P, 6.0 * e * self.inertia
-        X, Y = x[:, 0], x[:, 1]
         ux = -P * Y / c * ((6 * L - 3 * X) * X + (2 + nu) * (Y**2 - D**2 / 4))
         uy = P / c * (3 * nu * Y**2 * (L - X) + (4 + 5 * nu) * D**2 * X / 4 + (3 * L - X) * X**2)
-        return np.column_stack([ux, uy])
+        return ux, uy
 
     def gradient(self, x: np.ndarray) -> np.ndarray:
         """grad u(x), shape ``(m, 2, 2)`` with [i, j] = du_i/dx_j."""
