@@ -32,7 +32,7 @@ from verification.manufactured import SineField
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--nodes", type=int, default=300, help="nodes per side")
-    ap.add_argument("--solver", default="mumps", help="mumps | gmres-ilu | cg-gamg")
+    ap.add_argument("--solver", default="mumps", help="auto | mumps | gmres-ilu | cg-gamg")
     ap.add_argument("--save", help="write the coefficients (rank 0) to this .npy file")
     ap.add_argument("--compare", help="report the relative difference to these saved coefficients")
     args = ap.parse_args()
@@ -53,6 +53,7 @@ def main() -> None:
         return
     print("stages [s, max over ranks]: " + ", ".join(f"{k} {v:.2f}" for k, v in stages.items()))
     print("peak RSS per rank [MB]: " + ", ".join(f"{r:.0f}" for r in rss))
+    print(f"linear solve: {sol.linear['solver']}, {sol.linear['iterations']} iterations ({sol.linear['reason']})")
     if args.save:
         np.save(args.save, sol.coefficients)
     if args.compare:

@@ -16,8 +16,13 @@ import scipy.sparse as sp
 from rkfx.errors import InputError
 from rkfx.parallel.unknowns import RowSystem
 
+# The PETSc solvers by name (``rkfx.linalg.petsc.make_ksp``).
+SOLVERS = ("mumps", "gmres-ilu", "cg-gamg")
+
 
 class _ScipyLU:
+    iterations, reason = 1, "direct"  # of every solve, as reported by the PETSc solvers
+
     def __init__(self, a: sp.spmatrix):
         import scipy.sparse.linalg as spla  # noqa: PLC0415
 
@@ -55,6 +60,14 @@ class _RowSystemSolver:
         x = self._ls.solve(self.system.owned_values(b), whole=False)
         return self.system.local_values(x)
 
+    @property
+    def iterations(self) -> int:
+        return self._ls.iterations
+
+    @property
+    def reason(self) -> str:
+        return self._ls.reason
+
     def matches(self, a) -> bool:
         return False
 
@@ -64,7 +77,8 @@ class _RowSystemSolver:
 
 def linear_solver(a: sp.spmatrix, comm=None, solver: str = "mumps", mumps_icntl: Mapping[int, int] | None = None,
                   owned_rows: bool = False, coordinates: np.ndarray | None = None):
-    """An object with ``.solve(b)`` and ``.destroy()`` for the matrix ``a`` (``mumps_icntl``:
+    """An object with ``.solve(b)``, ``.destroy()`` and its last solve's ``.iterations`` and
+    ``.reason`` for the matrix ``a`` (``mumps_icntl``:
     further MUMPS controls, see ``rkfx.linalg.petsc.make_ksp``; ignored without PETSc).
     ``solver="serial"``: SuperLU on each rank, for a small system every rank holds whole.
     ``owned_rows``: ``a`` and every ``b`` are this rank's block of rows of a distributed system

@@ -17,8 +17,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from rkfx.errors import InputError, SolverError
-
-SOLVERS = ("mumps", "gmres-ilu", "cg-gamg")
+from rkfx.linalg.linear_solver import SOLVERS
 
 # Relative residual at which the Krylov solvers stop. CG + GAMG stops at 1e-8: on Timoshenko's
 # beam (bench/beam_scale.py, 263k nodes) the displacement error is the same to three digits
@@ -121,6 +120,7 @@ def make_ksp(mat: PETSc.Mat, solver: str = "mumps", rtol: float | None = None, p
     ksp = PETSc.KSP().create(mat.getComm())
     ksp.setOperators(mat)
     ksp.setOptionsPrefix(prefix)
+    rtol = RTOL.get(solver) if rtol is None else rtol
     pc = ksp.getPC()
     if solver == "mumps":
         ksp.setType("preonly")
@@ -138,11 +138,11 @@ def make_ksp(mat: PETSc.Mat, solver: str = "mumps", rtol: float | None = None, p
     elif solver == "gmres-ilu":
         ksp.setType("gmres")
         pc.setType("asm" if mat.getComm().size > 1 else "ilu")
-        ksp.setTolerances(rtol=RTOL[solver] if rtol is None else rtol, max_it=10000)
+        ksp.setTolerances(rtol=rtol, max_it=10000)
     else:
         ksp.setType("cg")
         pc.setType("gamg")
-        ksp.setTolerances(rtol=RTOL[solver] if rtol is None else rtol, max_it=10000)
+        ksp.setTolerances(rtol=rtol, max_it=10000)
         options = PETSc.Options(prefix)
         if not options.hasName("pc_gamg_threshold"):
             options.setValue("pc_gamg_threshold", GAMG_THRESHOLD)

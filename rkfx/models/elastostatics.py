@@ -14,7 +14,7 @@ from rkfx.assembly.boundary import (BC_METHODS, boundary_quadrature, nitsche_ter
                                     transformation_constraints)
 from rkfx.conditions import Condition, Displacement, Traction, split
 from rkfx.materials.elasticity import ElasticMaterial
-from rkfx.linalg.linear_solver import linear_solver
+from rkfx.linalg.linear_solver import SOLVERS, linear_solver
 from rkfx.errors import InputError
 from rkfx.geometry.nodal_domains import NodalDomains, nodal_domains
 from rkfx.assembly.operators import load_vector, stiffness
@@ -32,7 +32,7 @@ from rkfx.approximation.shape_functions import RKApproximation, evaluate, rk_app
 # and 0.14 s at 8.5k, 1.2 s and 0.52 s at 33k, 10.8 s and 2.2 s at 132k: below the switch both
 # are fast and the direct solve is the robust one; above it the fill of LU costs time and memory.
 AUTO_DIRECT_MAX_DOFS = 10_000
-SOLVER_CHOICES = ("auto", "mumps", "gmres-ilu", "cg-gamg")
+SOLVER_CHOICES = ("auto", *SOLVERS)
 
 
 def choose_solver(solver: str, n_dofs: int, bc_method: str, rule: str) -> str:
@@ -137,16 +137,10 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, conditions: Sequ
     ls = linear_solver(system, comm, solver, coordinates=p.x if gamg else None)
     del k, system  # PETSc holds its own copy
     x = ls.solve(rhs)
-    linear.update(_statistics(ls))
+    linear.update(iterations=ls.iterations, reason=ls.reason)
     ls.destroy()
     times["solve"] = time.perf_counter() - t0
     return ElasticSolution(rk, x[:2 * p.num_nodes].reshape(-1, 2), 2 * p.num_nodes, times, linear)
-
-
-def _statistics(ls) -> dict:
-    """Iterations and stopping reason of a linear solver's last solve (SciPy's LU: one, direct)."""
-    ls = getattr(ls, "_ls", ls)  # a distributed system's PETSc solver
-    return {"iterations": getattr(ls, "iterations", 1), "reason": getattr(ls, "reason", "direct")}
 
 
 def elastic_terms(p: Particles, rk: RKApproximation, domains: NodalDomains, material: ElasticMaterial,
@@ -221,7 +215,7 @@ def _solve_by_owned_rows(p: Particles, rk: RKApproximation, terms: dict, comm, s
     ls = linear_solver(block, comm, solver, owned_rows=True, coordinates=p.x[owned] if gamg else None)
     del block  # PETSc holds its own copy
     x = ls.solve(b)
-    linear.update(_statistics(ls))
+    linear.update(iterations=ls.iterations, reason=ls.reason)
     ls.destroy()
     times["solve"] = time.perf_counter() - t0
     return x[unknown[:2 * p.num_nodes]].reshape(-1, 2)
