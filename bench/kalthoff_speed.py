@@ -7,7 +7,10 @@ side (450: 450 x 451 = 202,950 particles, h = 0.1 / 449 m, the seed's finest mod
 energy bookkeeping; JIT compilation excluded by a warm-up run), steps and time per step, and
 the split of one step between the two sparse products over the subcell rows (the strains:
 cell strains and MSCNI differences; the force), the damage kernels and the rest, measured on
-the final state.
+the final state. For the two products: the bytes each must move, the bandwidth that makes,
+its ratio to the machine's STREAM triad (``bench/stream.py``, measured in the same process),
+and their time on one thread, which tells a memory-bound product (no faster on two threads)
+from a compute-bound one (twice as fast).
 
 Usage: python bench/kalthoff_speed.py [--nodes 450] [--t-end 8e-5]
 The last line reads ``<N> particles: <seconds> s for <T> us``.
@@ -15,7 +18,16 @@ The last line reads ``<N> particles: <seconds> s for <T> us``.
 import argparse
 import time
 
+import numba
 import numpy as np
+from stream import bandwidth
+
+
+def product_bytes(rows, num_subcells: int, num_nodes: int) -> int:
+    """The bytes one product over ``rows`` (the subcell rows or their transpose) moves at the
+    least: its indices, values and row pointers once, the three strains or loads of each
+    subcell once, the two coefficients or forces of each node once (the gathers hit the caches)."""
+    return rows.indices.nbytes + rows.data.nbytes + rows.indptr.nbytes + 24 * num_subcells + 16 * num_nodes
 
 
 def main(argv=None):
@@ -65,12 +77,29 @@ def main(argv=None):
     t_all = (time.perf_counter() - t) / reps
     per_step = run.wall_time_s / run.steps
     stab = pl.op.stabilization
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    t = time.perf_counter()
+    for _ in range(reps // 4):
+        e, diff = pl.op.strains(d)
+    t_strain_1 = (time.perf_counter() - t) / (reps // 4)
+    t = time.perf_counter()
+    for _ in range(reps // 4):
+        pl.op.force(e, diff)
+    t_force_1 = (time.perf_counter() - t) / (reps // 4)
+    numba.set_num_threads(threads)
+    stream = bandwidth(mib=256, reps=5)["triad"]
+    m = len(stab.owner)
+    b_strain, b_force = product_bytes(stab.rows, m, n), product_bytes(stab.rows_t, m, n)
     print(f"particles {n:,} (grid {len(pl.xs)} x {len(pl.ys)}), subcells {len(stab.owner):,}, "
           f"nnz(grad N over subcells) {stab.rows.indices.size:,}, h = {1e6 * pl.h:.1f} um, dt = {1e9 * pl.dt:.2f} ns")
     print(f"set-up {setup:.1f} s; {run.steps} steps in {run.wall_time_s:.1f} s = {1e3 * per_step:.1f} ms per step")
     print(f"one step: strains {1e3 * t_strain:.1f} ms, force {1e3 * t_force:.1f} ms, damage force in all "
           f"{1e3 * t_all:.1f} ms (kernels and tracking {1e3 * (t_all - t_strain - t_force):.1f} ms), "
           f"rest of the step {1e3 * (per_step - t_all):.1f} ms")
+    for name, b, t2, t1 in (("strains", b_strain, t_strain, t_strain_1), ("force", b_force, t_force, t_force_1)):
+        print(f"{name}: {b / 1e6:.0f} MB per step, {b / t2 / 1e9:.1f} GB/s = {b / t2 / 1e9 / stream:.2f} of the "
+              f"stream triad ({stream:.1f} GB/s); {1e3 * t1:.1f} ms on 1 thread, {1e3 * t2:.1f} ms on {threads}")
     cracked = int((run.opening >= 0.5).sum())
     print(f"dissipated {run.history[-1, 1]:.0f} J/m, cracked particles (w / w_c >= 0.5) {cracked}, "
           f"energy balance error {run.energy_error:.1e}")

@@ -54,3 +54,21 @@ def test_compiled_stiffness_does_not_depend_on_the_thread_count():
         numba.set_num_threads(threads)
     assert np.array_equal(one.indptr, many.indptr) and np.array_equal(one.indices, many.indices)
     assert np.array_equal(one.data, many.data)
+
+
+def test_rows_read_in_their_sets_give_the_stiffness_of_one_joined_set():
+    """The SCNI and MSCNI rows are read where they are, in two sets (and a third is joined to
+    the second): K is the one of all the rows copied into one list, bit for bit."""
+    from rkfx.assembly.galerkin import _joined  # noqa: PLC0415
+
+    p = unit_square(0.08)
+    rk, dom = rk_approximation(p.x, p.spacing), nodal_domains(p)
+    cell, sub = integration_rules("mscni", p, rk, dom)
+    gauss = integration_rules("gauss2", p, rk, dom)[0]
+    d = ElasticMaterial(2.0, 0.3).D()
+    for quads in ([cell, sub], [cell, sub, gauss]):
+        w = np.concatenate([q.weights for q in quads])
+        parts = elastic_stiffness([q.gradients for q in quads], w, d)
+        joined = elastic_stiffness(_joined([q.gradients for q in quads]), w, d)
+        for name in ("indptr", "indices", "data"):
+            assert np.array_equal(getattr(parts, name), getattr(joined, name)), name

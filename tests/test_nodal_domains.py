@@ -81,3 +81,44 @@ def test_domains_around_some_nodes_give_their_cells_as_the_whole_build():
     for x, y in ((a.cell, b.cell), (a.cell_minus_subcell, b.cell_minus_subcell)):
         assert np.array_equal(x.indptr, y.indptr) and np.array_equal(x.indices, y.indices)
         assert np.abs(x.data - y.data).max() <= 1e-12 * np.abs(x.data).max()
+
+
+@pytest.mark.parametrize("nodes", [None, "some"])
+def test_smoothed_gradients_in_blocks_of_points_equal_one_block(monkeypatch, nodes):
+    """N is evaluated a block of smoothing points at a time (``POINTS_PER_BLOCK``); the cell
+    rows, MSCNI rows and their order are the same bit for bit as from one block."""
+    from rkfx.approximation.shape_functions import rk_approximation  # noqa: PLC0415
+    import rkfx.integration.quadrature as quadrature  # noqa: PLC0415
+
+    p = unit_square(0.05)
+    rk = rk_approximation(p.x, p.spacing)
+    d = nodal_domains(p)
+    sel = None if nodes is None else np.arange(3, p.num_nodes, 2)
+    one = quadrature.smoothed_gradients(p, rk, d, nodes=sel)
+    monkeypatch.setattr(quadrature, "POINTS_PER_BLOCK", 37)
+    many = quadrature.smoothed_gradients(p, rk, d, nodes=sel)
+    assert np.array_equal(one.subcells, many.subcells)
+    for x, y in ((one.cell, many.cell), (one.cell_minus_subcell, many.cell_minus_subcell)):
+        assert x.num_rows > 0
+        for name in ("indptr", "indices", "data"):
+            assert np.array_equal(getattr(x, name), getattr(y, name)), name
+
+
+def test_stacked_rows_grow_past_a_short_first_guess():
+    """Rows stacked from jobs whose later rows are longer than the first job's outgrow the
+    first allocation and still come out whole, in order."""
+    from rkfx.approximation.sparse_rows import SparseRows, combine_job, stacked_rows  # noqa: PLC0415
+
+    src = SparseRows(np.arange(0, 21, 1, dtype=np.int64), np.arange(20, dtype=np.int32), np.ones((20, 1)), 20)
+    rows = [[0], [1], [2, 3, 4, 5], [6, 7, 8, 9, 10, 11, 12], [13, 14, 15, 16, 17, 18, 19]]
+
+    def job(rs):
+        ptr = np.cumsum([0] + [len(r) for r in rs])
+        terms = np.concatenate([np.array(r) for r in rs])
+        return combine_job(src, ptr, terms, np.arange(1.0, len(terms) + 1))
+
+    out = stacked_rows((job(rows[i:i + 2]) for i in range(0, 5, 2)), len(rows), slack=1.0)
+    assert np.array_equal(out.indptr, np.cumsum([0] + [len(r) for r in rows]))
+    assert np.array_equal(out.indices, np.arange(20))
+    expected = np.concatenate([np.arange(1.0, 3.0), np.arange(1.0, 12.0), np.arange(1.0, 8.0)])
+    assert np.array_equal(out.data[:, 0], expected)

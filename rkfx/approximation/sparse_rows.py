@@ -5,6 +5,7 @@ nodes it couples to and a small vector per node (N_I, or the gradient of N_I). S
 gradients (eq. 3.55) and MSCNI differences (3.56) are sparse linear combinations of such
 rows, formed by ``combine_rows`` in parallel with a sparse accumulator.
 """
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numba
@@ -119,20 +120,129 @@ def work_items(nrows: int) -> int:
     return max(1, min(nrows, ITEMS_PER_THREAD * numba.get_num_threads()))
 
 
-def _count_then_fill(kernel, args: tuple, nrows: int, nc: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """CSR ``(indptr, indices, data)`` of a two-pass row kernel: count the entries per row, then fill."""
-    out_ptr = np.zeros(nrows + 1, np.int64)
-    kernel(*args, out_ptr, np.empty(0, np.int32), np.empty((0, nc)), False)
-    np.cumsum(out_ptr, out=out_ptr)
+@dataclass(frozen=True)
+class RowJob:
+    """The rows a two-pass row kernel forms (``kernel(*args, out_ptr, out_idx, out_data, fill)``):
+    ``count`` their lengths, then ``fill`` arrays of the counted size, its own (``rows``) or the
+    next part of a buffer shared by many jobs (``stacked_rows``)."""
+
+    kernel: object
+    args: tuple
+    num_rows: int
+    num_components: int
+    num_cols: int
+
+    def count(self) -> np.ndarray:
+        """Row pointers of the rows, shape ``(num_rows + 1,)`` (from 0)."""
+        out_ptr = np.zeros(self.num_rows + 1, np.int64)
+        self.kernel(*self.args, out_ptr, np.empty(0, np.int32), np.empty((0, self.num_components)), False)
+        np.cumsum(out_ptr, out=out_ptr)
+        return out_ptr
+
+    def fill(self, out_ptr: np.ndarray, out_idx: np.ndarray, out_data: np.ndarray) -> None:
+        """Write the rows' entries to ``out_idx[:out_ptr[-1]]``, ``out_data[:out_ptr[-1]]``."""
+        self.kernel(*self.args, out_ptr, out_idx, out_data, True)
+
+    def rows(self) -> SparseRows:
+        out_ptr = self.count()
+        out_idx = np.empty(out_ptr[-1], np.int32)
+        out_data = np.empty((out_ptr[-1], self.num_components))
+        self.fill(out_ptr, out_idx, out_data)
+        return SparseRows(out_ptr, out_idx, out_data, self.num_cols)
+
+
+class RowStack:
+    """Rows appended a job at a time into buffers that grow, for rows formed in pieces whose
+    sizes are known only once each piece is counted (``stacked_rows``).
+
+    The buffers are allocated at the first job, for its entries per row times ``num_rows``
+    (the rows expected in all) times ``slack``; the operating system backs only the pages
+    written, so the slack costs address space, not memory. A job that overflows them grows
+    them by half (a copy).
+    """
+
+    def __init__(self, num_rows: int, slack: float = 1.25):
+        self.indptr = np.zeros(num_rows + 1, np.int64)
+        self.indices = self.data = None
+        self.num_rows_expected, self.slack = num_rows, slack
+        self.count = self.nnz = 0
+        self.num_cols, self.num_components = 0, 1
+
+    def append(self, job: RowJob) -> None:
+        """Count and fill the rows of ``job`` after those appended so far."""
+        ptr = job.count()
+        m, k = job.num_rows, int(ptr[-1])
+        self.num_cols, self.num_components = job.num_cols, job.num_components
+        if self.indices is None:
+            capacity = max(k, int(self.slack * k / max(m, 1) * self.num_rows_expected) + 1)
+            self.indices, self.data = np.empty(capacity, np.int32), np.empty((capacity, job.num_components))
+        if self.nnz + k > len(self.indices):
+            capacity = max(self.nnz + k, int(1.5 * len(self.indices)))
+            self.indices, self.data = _grown(self.indices, self.nnz, capacity), _grown(self.data, self.nnz, capacity)
+        if self.count + m > self.num_rows_expected:
+            raise ValueError(f"RowStack: {self.count + m} rows appended, {self.num_rows_expected} were announced")
+        job.fill(ptr, self.indices[self.nnz:self.nnz + k], self.data[self.nnz:self.nnz + k])
+        self.indptr[self.count + 1:self.count + m + 1] = ptr[1:] + self.nnz
+        self.count, self.nnz = self.count + m, self.nnz + k
+
+    def rows(self) -> SparseRows:
+        """The rows appended so far (views of the buffers)."""
+        if self.indices is None:
+            return SparseRows(self.indptr[:1], np.empty(0, np.int32), np.empty((0, self.num_components)), self.num_cols)
+        return SparseRows(self.indptr[:self.count + 1], self.indices[:self.nnz], self.data[:self.nnz], self.num_cols)
+
+
+def stacked_rows(jobs: Iterable[RowJob], num_rows: int, slack: float = 1.25) -> SparseRows:
+    """The rows of ``jobs`` (consecutive, ``num_rows`` in all), one after another, each job's
+    rows written straight into the result (a ``RowStack``) and the job dropped before the next
+    is made, so that no more than the result and one job's inputs are held at a time."""
+    stack = RowStack(num_rows, slack)
+    for job in jobs:
+        stack.append(job)
+        del job
+    if stack.count != num_rows:
+        raise ValueError(f"stacked_rows: the jobs form {stack.count} rows, {num_rows} were announced")
+    return stack.rows()
+
+
+@numba.njit(parallel=True, cache=True)
+def _gather(indptr, indices, data, rows, out_ptr, out_idx, out_data):
+    for r in numba.prange(len(rows)):
+        src = indptr[rows[r]]
+        for k in range(out_ptr[r + 1] - out_ptr[r]):
+            out_idx[out_ptr[r] + k] = indices[src + k]
+            for c in range(data.shape[1]):
+                out_data[out_ptr[r] + k, c] = data[src + k, c]
+
+
+def gathered_rows(rows: SparseRows, which: np.ndarray) -> SparseRows:
+    """The rows ``which`` of ``rows``, in that order, each row's entries in their order."""
+    which = np.ascontiguousarray(which, dtype=np.int64)
+    out_ptr = np.zeros(len(which) + 1, np.int64)
+    np.cumsum(np.diff(rows.indptr)[which], out=out_ptr[1:])
     out_idx = np.empty(out_ptr[-1], np.int32)
-    out_data = np.empty((out_ptr[-1], nc))
-    kernel(*args, out_ptr, out_idx, out_data, True)
-    return out_ptr, out_idx, out_data
+    out_data = np.empty((out_ptr[-1], rows.num_components))
+    _gather(rows.indptr, rows.indices, np.ascontiguousarray(rows.data), which, out_ptr, out_idx, out_data)
+    return SparseRows(out_ptr, out_idx, out_data, rows.num_cols)
+
+
+def _grown(a: np.ndarray, used: int, capacity: int) -> np.ndarray:
+    """A buffer of ``capacity`` rows holding the first ``used`` rows of ``a`` (the rest unwritten)."""
+    out = np.empty((capacity, *a.shape[1:]), a.dtype)
+    out[:used] = a[:used]
+    return out
 
 
 def combine_rows(source: SparseRows, term_ptr: np.ndarray, term_row: np.ndarray,
                  term_weight: np.ndarray, base: SparseRows | None = None,
                  base_row: np.ndarray | None = None) -> SparseRows:
+    """Rows formed as weighted sums of source rows (``combine_job``, formed at once)."""
+    return combine_job(source, term_ptr, term_row, term_weight, base, base_row).rows()
+
+
+def combine_job(source: SparseRows, term_ptr: np.ndarray, term_row: np.ndarray,
+                term_weight: np.ndarray, base: SparseRows | None = None,
+                base_row: np.ndarray | None = None) -> RowJob:
     """Rows formed as weighted sums of scalar source rows, optionally added to base rows.
 
     Output row r is ``base[base_row[r]] + sum_t w_t * source[term_row[t]]`` for t in
@@ -160,7 +270,7 @@ def combine_rows(source: SparseRows, term_ptr: np.ndarray, term_row: np.ndarray,
                      np.ascontiguousarray(base_row, dtype=np.int64))
     args = (source.indptr, source.indices, np.ascontiguousarray(source.data[:, 0]), term_ptr, term_row, w,
             source.num_cols, work_items(nrows), *base_args)
-    return SparseRows(*_count_then_fill(_combine, args, nrows, w.shape[1]), source.num_cols)
+    return RowJob(_combine, args, nrows, w.shape[1], source.num_cols)
 
 
 @numba.njit(parallel=True, cache=True)
@@ -206,4 +316,4 @@ def difference_rows(a: SparseRows, a_row: np.ndarray, b: SparseRows) -> SparseRo
     nc = a.num_components
     args = (a.indptr, a.indices, np.ascontiguousarray(a.data), a_row, b.indptr, b.indices,
             np.ascontiguousarray(b.data), a.num_cols, work_items(nrows))
-    return SparseRows(*_count_then_fill(_difference, args, nrows, nc), a.num_cols)
+    return RowJob(_difference, args, nrows, nc, a.num_cols).rows()

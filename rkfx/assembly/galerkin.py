@@ -10,8 +10,15 @@ order (points ascending, then the entries of each point's row) on any number of 
 columns of each row come out sorted, and the transposed entries come from a counting sort:
 no sort of the whole entry list, no sort of K afterwards.
 
+The points may come in two sets of rows (the SCNI cells and the MSCNI subcells of eq. 3.56),
+read where they are: the points of the second follow those of the first, and nothing is
+copied into one list. The transposed entries and the point of each entry are int32 (half of
+int64's bytes, the largest arrays of the assembly after the rows) while they fit.
+
 B(g) of a gradient g = (g_x, g_y) is the Voigt strain matrix [[g_x, 0], [0, g_y], [g_y, g_x]].
 """
+from collections.abc import Sequence
+
 import numba
 import numpy as np
 import scipy.sparse as sp
@@ -20,10 +27,13 @@ from rkfx.approximation.sparse_rows import SparseRows, work_items
 
 
 @numba.njit(parallel=True, cache=True)
-def _stiffness(ptr, idx, grad, point_of, t_ptr, t_entry, weight, d, per_point, num_nodes, nchunks,
-               node_ptr, out_idx, out_data, fill):
-    """Count (``fill`` False: node_ptr[I + 1] = distinct J of row I) or fill the CSR of K."""
+def _stiffness(ptr_a, idx_a, grad_a, ptr_b, idx_b, grad_b, point_of, t_ptr, t_entry, weight, d, per_point,
+               num_nodes, nchunks, node_ptr, out_idx, out_data, fill):
+    """Count (``fill`` False: node_ptr[I + 1] = distinct J of row I) or fill the CSR of K, over
+    the points of rows A and then rows B (entry p >= len(idx_a) is entry p - len(idx_a) of B)."""
     chunk = (num_nodes + nchunks - 1) // nchunks
+    m_a = len(ptr_a) - 1
+    nnz_a = len(idx_a)
     for c in numba.prange(nchunks):
         stamp = np.full(num_nodes, -1, np.int64)
         slot = np.empty(num_nodes, np.int64)
@@ -36,7 +46,8 @@ def _stiffness(ptr, idx, grad, point_of, t_ptr, t_entry, weight, d, per_point, n
                 cols = np.empty(width, np.int64)
                 for e_i in range(t_ptr[i], t_ptr[i + 1]):
                     q = point_of[t_entry[e_i]]
-                    for e in range(ptr[q], ptr[q + 1]):
+                    ptr, idx, off = (ptr_a, idx_a, q) if q < m_a else (ptr_b, idx_b, q - m_a)
+                    for e in range(ptr[off], ptr[off + 1]):
                         j = idx[e]
                         if stamp[j] != i:
                             stamp[j] = i
@@ -54,14 +65,16 @@ def _stiffness(ptr, idx, grad, point_of, t_ptr, t_entry, weight, d, per_point, n
             for e_i in range(t_ptr[i], t_ptr[i + 1]):
                 p = t_entry[e_i]
                 q = point_of[p]
+                ptr, idx, grad, off = (ptr_a, idx_a, grad_a, q) if q < m_a else (ptr_b, idx_b, grad_b, q - m_a)
                 if fill:
                     # t = B_I^T (w D): 2 x 3.
                     m = d[q] if per_point else d[0]
-                    gx, gy, w = grad[p, 0], grad[p, 1], weight[q]
+                    pe = p if p < nnz_a else p - nnz_a
+                    gx, gy, w = grad[pe, 0], grad[pe, 1], weight[q]
                     for s in range(3):
                         t[0, s] = w * (gx * m[0, s] + gy * m[2, s])
                         t[1, s] = w * (gy * m[1, s] + gx * m[2, s])
-                for e in range(ptr[q], ptr[q + 1]):
+                for e in range(ptr[off], ptr[off + 1]):
                     j = idx[e]
                     if not fill:
                         if stamp[j] != i:
@@ -78,26 +91,33 @@ def _stiffness(ptr, idx, grad, point_of, t_ptr, t_entry, weight, d, per_point, n
                 node_ptr[i + 1] = k
 
 
-def elastic_stiffness(rows: SparseRows, weights: np.ndarray, d: np.ndarray) -> sp.csr_matrix:
+def elastic_stiffness(rows: SparseRows | Sequence[SparseRows], weights: np.ndarray, d: np.ndarray) -> sp.csr_matrix:
     """K = sum_q w_q B_q^T D_q B_q, shape ``(2 n, 2 n)`` over interleaved unknowns, sorted indices.
 
     Args:
-        rows: Gradient rows grad N_I(x_q), 2 components, shape ``(m, n)``.
+        rows: Gradient rows grad N_I(x_q), 2 components, shape ``(m, n)``; or a list of such
+            rows over the same n nodes, whose points follow each other (m = their sum).
         weights: w_q, shape ``(m,)`` [m^2].
         d: D [Pa], shape ``(3, 3)`` or one per point ``(m, 3, 3)``.
     """
-    n, m = rows.num_cols, rows.num_rows
+    parts = [rows] if isinstance(rows, SparseRows) else list(rows)
+    if len(parts) > 2:  # the kernel reads two sets where they are; more are joined into the second
+        parts = [parts[0], _joined(parts[1:])]
+    a = parts[0]
+    b = parts[1] if len(parts) > 1 else SparseRows(np.zeros(1, np.int64), a.indices[:0], a.data[:0], a.num_cols)
+    n = a.num_cols
+    m = a.num_rows + b.num_rows
+    nnz = a.indices.size + b.indices.size
+    index = np.int32 if max(nnz, m) < 2**31 else np.int64
     d = np.ascontiguousarray(d, dtype=np.float64)
     per_point = d.ndim == 3
     d = d if per_point else d.reshape(1, 3, 3)
-    idx = np.ascontiguousarray(rows.indices)
-    point_of = np.repeat(np.arange(m, dtype=np.int64), np.diff(rows.indptr))
     t_ptr = np.zeros(n + 1, np.int64)
-    np.cumsum(np.bincount(idx, minlength=n), out=t_ptr[1:])
-    t_entry = _transposed_entries(idx, t_ptr)
-    args = (rows.indptr, idx, np.ascontiguousarray(rows.data, dtype=np.float64), point_of, t_ptr, t_entry,
-            np.ascontiguousarray(weights, dtype=np.float64), d, per_point, n,
-            work_items(n))
+    np.cumsum(np.bincount(a.indices, minlength=n) + np.bincount(b.indices, minlength=n), out=t_ptr[1:])
+    t_entry = _transposed_entries(a.indices, b.indices, t_ptr, np.empty(nnz, index))
+    point_of = _entry_points(a.indptr, b.indptr, np.empty(nnz, index))
+    args = (a.indptr, np.ascontiguousarray(a.indices), _grad(a), b.indptr, np.ascontiguousarray(b.indices), _grad(b),
+            point_of, t_ptr, t_entry, np.ascontiguousarray(weights, dtype=np.float64), d, per_point, n, work_items(n))
     node_ptr = np.zeros(n + 1, np.int64)
     _stiffness(*args, node_ptr, np.empty(0, np.int32), np.empty(0), False)
     np.cumsum(node_ptr, out=node_ptr)
@@ -113,13 +133,42 @@ def elastic_stiffness(rows: SparseRows, weights: np.ndarray, d: np.ndarray) -> s
     return k
 
 
+def _grad(rows: SparseRows) -> np.ndarray:
+    return np.ascontiguousarray(rows.data, dtype=np.float64)
+
+
+def _joined(parts: list[SparseRows]) -> SparseRows:
+    """One set of rows of several (a copy)."""
+    starts = np.cumsum([0] + [g.indptr[-1] for g in parts[:-1]])
+    return SparseRows(np.concatenate([parts[0].indptr[:1]] + [g.indptr[1:] + s for g, s in zip(parts, starts)]),
+                      np.concatenate([g.indices for g in parts]), np.concatenate([g.data for g in parts]),
+                      parts[0].num_cols)
+
+
 @numba.njit(cache=True)
-def _transposed_entries(idx, t_ptr):
-    """The entries e of each column idx[e], in order of e (a stable counting sort): the entries
-    of node I are ``out[t_ptr[I]:t_ptr[I + 1]]``."""
+def _transposed_entries(idx_a, idx_b, t_ptr, out):
+    """The entries e of each column, in order of e over the entries of A and then of B (a
+    stable counting sort): the entries of node I are ``out[t_ptr[I]:t_ptr[I + 1]]``."""
     cursor = t_ptr[:-1].copy()
-    out = np.empty(len(idx), np.int64)
-    for e in range(len(idx)):
-        out[cursor[idx[e]]] = e
-        cursor[idx[e]] += 1
+    nnz_a = len(idx_a)
+    for e in range(nnz_a):
+        out[cursor[idx_a[e]]] = e
+        cursor[idx_a[e]] += 1
+    for e in range(len(idx_b)):
+        out[cursor[idx_b[e]]] = nnz_a + e
+        cursor[idx_b[e]] += 1
+    return out
+
+
+@numba.njit(parallel=True, cache=True)
+def _entry_points(ptr_a, ptr_b, out):
+    """The point of every entry of A, then of B (whose points follow A's)."""
+    m_a = len(ptr_a) - 1
+    nnz_a = ptr_a[-1]
+    for q in numba.prange(m_a):
+        for e in range(ptr_a[q], ptr_a[q + 1]):
+            out[e] = q
+    for q in numba.prange(len(ptr_b) - 1):
+        for e in range(ptr_b[q], ptr_b[q + 1]):
+            out[nnz_a + e] = m_a + q
     return out

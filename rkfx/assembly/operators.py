@@ -52,16 +52,13 @@ def stiffness(quadratures: list[Quadrature], d) -> sp.csr_matrix:
     ds = [np.asarray(dq, float) for dq in _per_quadrature(d, quadratures)]
     if len(quadratures) == 1:
         return elastic_stiffness(quadratures[0].gradients, quadratures[0].weights, ds[0])
-    # One pass over all the points (cell and subcell rows): no sum of whole matrices.
-    grads = [q.gradients for q in quadratures]
-    starts = np.cumsum([0] + [g.indptr[-1] for g in grads[:-1]])
-    rows = SparseRows(np.concatenate([grads[0].indptr[:1]] + [g.indptr[1:] + s for g, s in zip(grads, starts)]),
-                      np.concatenate([g.indices for g in grads]), np.concatenate([g.data for g in grads]),
-                      grads[0].num_cols)
+    # One pass over all the points (cell and subcell rows, read where they are): no sum of
+    # whole matrices, no copy of the rows into one list.
     same = all(dq.shape == (3, 3) and np.array_equal(dq, ds[0]) for dq in ds)
     d_all = ds[0] if same else np.concatenate([np.broadcast_to(dq, (len(q.weights), 3, 3))
                                                for q, dq in zip(quadratures, ds)])
-    return elastic_stiffness(rows, np.concatenate([q.weights for q in quadratures]), d_all)
+    return elastic_stiffness([q.gradients for q in quadratures], np.concatenate([q.weights for q in quadratures]),
+                             d_all)
 
 
 def laplacian(quadratures: list[Quadrature], k=1.0) -> sp.csr_matrix:

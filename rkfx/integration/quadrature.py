@@ -12,13 +12,15 @@ same code for elasticity, Darcy flow and coupling (``rkfx.assembly.operators``).
 """
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from rkfx.errors import InputError
 from rkfx.geometry.nodal_domains import NodalDomains
 from rkfx.geometry.particles import Particles
 from rkfx.approximation.shape_functions import RKApproximation, evaluate
-from rkfx.approximation.sparse_rows import SparseRows, combine_rows, difference_rows
+from rkfx.approximation.sparse_rows import (RowStack, SparseRows, combine_job, combine_rows, difference_rows,
+                                           gathered_rows, stacked_rows)
 
 # Symmetric Gauss rules on the reference triangle: barycentric points and weights (sum 1).
 _TRIANGLE_RULES = {
@@ -96,6 +98,12 @@ class SmoothedGradients:
     subcells: np.ndarray
 
 
+# N is evaluated at about this many smoothing points at a time: the rows of one block of points
+# are held (~0.15 GB), never those of all (1.3 GB at 10^6 nodes), and each block's combined rows
+# go straight into the result (``stacked_rows``).
+POINTS_PER_BLOCK = 1_000_000
+
+
 def smoothed_gradients(p: Particles, rk: RKApproximation, domains: NodalDomains,
                        subcells: bool = True, nodes: np.ndarray | None = None) -> SmoothedGradients:
     """N at the smoothing points, combined into cell smoothed gradients and, with ``subcells``,
@@ -103,45 +111,111 @@ def smoothed_gradients(p: Particles, rk: RKApproximation, domains: NodalDomains,
 
     ``nodes`` (indices) restricts the rows to the cells of those nodes and their subcells (a
     rank's owned cells, ``rkfx.parallel.ownership``): N is then evaluated only at their
-    smoothing points; the columns stay all nodes.
+    smoothing points; the columns stay all nodes. The points are taken in blocks of about
+    ``POINTS_PER_BLOCK``; every row is the same, entry for entry, whatever the blocks.
     """
     d = domains
     num_cells = len(d.area)
     if nodes is None:
-        nodes, sub, used = np.arange(num_cells), np.arange(len(d.subcell_area)), None
-        ptr, terms = d.cell_ptr, np.arange(len(d.cell_point))
+        nodes, sub = np.arange(num_cells), np.arange(len(d.subcell_area))
     else:
         nodes = np.asarray(nodes, dtype=np.int64)
         mine = np.zeros(num_cells, bool)
         mine[nodes] = True
         sub = np.flatnonzero(mine[d.subcell_node])
-        lengths = np.diff(d.cell_ptr)[nodes]
-        ptr = np.zeros(len(nodes) + 1, np.int64)
-        np.cumsum(lengths, out=ptr[1:])
-        terms = np.repeat(d.cell_ptr[nodes] - ptr[:-1], lengths) + np.arange(ptr[-1])
-        keep = np.zeros(len(d.smoothing_points), bool)  # a mask: linear time, unlike a sort
-        keep[d.cell_point[terms]] = True
-        if subcells:
-            keep[d.subcell_point[sub].ravel()] = True
-        used = np.flatnonzero(keep)
-        position = np.full(len(keep), -1, np.int64)
-        position[used] = np.arange(len(used))
-
-    def local(point):  # index among the evaluated smoothing points
-        return point if used is None else position[point]
-
-    at_points = evaluate(rk, d.smoothing_points if used is None else d.smoothing_points[used])
-    cell = combine_rows(at_points, ptr, local(d.cell_point[terms]),
-                        d.cell_normal_length[terms] / np.repeat(d.area[nodes], np.diff(ptr))[:, None])
-    diff = None
+    slot = np.full(len(d.smoothing_points), -1, np.int32)
     if subcells:
-        row_of = np.full(num_cells, -1, np.int64)
-        row_of[nodes] = np.arange(len(nodes))
-        ns = len(sub)
-        diff = combine_rows(at_points, np.arange(0, 4 * ns + 1, 4), local(d.subcell_point[sub].ravel()),
-                            (-d.subcell_normal_length[sub] / d.subcell_area[sub, None, None]).reshape(-1, 2),
-                            base=cell, base_row=row_of[d.subcell_node[sub]])
+        cell, diff = _cells_and_subcells(rk, d, nodes, sub, slot)
+    else:
+        cell, diff = stacked_rows(_cell_blocks(rk, d, nodes, slot), len(nodes)), None
     return SmoothedGradients(cell, evaluate(rk, p.x[nodes]), diff, nodes, sub)
+
+
+def _block_bounds(counts: np.ndarray, per_block: int) -> list[tuple[int, int]]:
+    """Consecutive ranges of the items with ``counts`` points each, about ``per_block`` points a range."""
+    total = np.cumsum(counts)
+    if total.size == 0:
+        return [(0, 0)]
+    cuts = np.searchsorted(total, np.arange(per_block, total[-1], per_block), side="right")
+    bounds = np.unique(np.concatenate([[0], cuts, [len(counts)]]))
+    return list(zip(bounds[:-1].tolist(), bounds[1:].tolist()))
+
+
+@numba.njit(cache=True)
+def _renumber(point, slot):
+    """The distinct entries of ``point`` in the order first met, and the place of each entry
+    among them; ``slot`` (-1 everywhere, one per point of the domains) is left as it was found."""
+    local = np.empty(len(point), np.int64)
+    seen = np.empty(len(point), np.int64)
+    k = 0
+    for t in range(len(point)):
+        j = point[t]
+        s = slot[j]
+        if s < 0:
+            s = k
+            slot[j] = k
+            seen[k] = j
+            k += 1
+        local[t] = s
+    for t in range(k):
+        slot[seen[t]] = -1
+    return seen[:k].copy(), local
+
+
+def _cell_terms(d: NodalDomains, block: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The cell-boundary segments of the nodes ``block``: their row pointer, their indices and
+    their weights n l / A_L (eq. 3.55)."""
+    n = np.diff(d.cell_ptr)[block]
+    ptr = np.zeros(len(block) + 1, np.int64)
+    np.cumsum(n, out=ptr[1:])
+    terms = np.repeat(d.cell_ptr[block] - ptr[:-1], n) + np.arange(ptr[-1])
+    return ptr, terms, d.cell_normal_length[terms] / np.repeat(d.area[block], n)[:, None]
+
+
+def _cell_blocks(rk: RKApproximation, d: NodalDomains, nodes: np.ndarray, slot: np.ndarray):
+    """The cell rows of ``nodes`` (eq. 3.55), a block of nodes at a time."""
+    for lo, hi in _block_bounds(np.diff(d.cell_ptr)[nodes], POINTS_PER_BLOCK):
+        ptr, terms, weight = _cell_terms(d, nodes[lo:hi])
+        points, local = _renumber(d.cell_point[terms], slot)
+        yield combine_job(evaluate(rk, d.smoothing_points[points]), ptr, local, weight)
+
+
+def _cells_and_subcells(rk: RKApproximation, d: NodalDomains, nodes: np.ndarray, sub: np.ndarray, slot: np.ndarray
+                        ) -> tuple[SparseRows, SparseRows]:
+    """The cell rows of ``nodes`` and the MSCNI rows grad~N(x_L) - grad~N(x_hat_C) of their
+    subcells ``sub`` (eqs. 3.55-3.56), a block of subcells at a time.
+
+    A block evaluates N once, at its subcells' sides and at the cell boundaries of the nodes
+    whose cell rows it is the first to need (a cell's boundary segments are sides of its
+    subcells: mostly the same points). Cell rows are formed in the order first needed and put
+    in the order of ``nodes`` at the end.
+    """
+    owner = d.subcell_node[sub]
+    where = np.full(len(d.area), -1, np.int64)  # row of each node's cell among those formed
+    cells, diff = RowStack(len(nodes)), RowStack(len(sub))
+    for lo, hi in _block_bounds(np.full(len(sub), 4), POINTS_PER_BLOCK):
+        block = sub[lo:hi]
+        new = np.unique(owner[lo:hi])
+        new = new[where[new] < 0]
+        ptr, terms, weight = _cell_terms(d, new)
+        points, local = _renumber(np.concatenate([d.cell_point[terms], d.subcell_point[block].ravel()]), slot)
+        at = evaluate(rk, d.smoothing_points[points])
+        where[new] = cells.count + np.arange(len(new))
+        cells.append(combine_job(at, ptr, local[:len(terms)], weight))
+        diff.append(combine_job(at, np.arange(0, 4 * len(block) + 1, 4), local[len(terms):],
+                                (-d.subcell_normal_length[block] / d.subcell_area[block, None, None]).reshape(-1, 2),
+                                base=cells.rows(), base_row=where[owner[lo:hi]]))
+        del at
+    rest = nodes[where[nodes] < 0]  # cells without subcells
+    if rest.size:
+        where[rest] = cells.count + np.arange(len(rest))
+        for job in _cell_blocks(rk, d, rest, slot):
+            cells.append(job)
+    order = where[nodes]
+    cell = cells.rows()
+    if not np.array_equal(order, np.arange(len(nodes))):
+        cell = gathered_rows(cell, order)
+    return cell, diff.rows()
 
 
 def subcell_gradients(rk: RKApproximation, domains: NodalDomains, nodes: np.ndarray | None = None
