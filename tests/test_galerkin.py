@@ -72,3 +72,24 @@ def test_rows_read_in_their_sets_give_the_stiffness_of_one_joined_set():
         joined = elastic_stiffness(_joined([q.gradients for q in quads]), w, d)
         for name in ("indptr", "indices", "data"):
             assert np.array_equal(getattr(parts, name), getattr(joined, name)), name
+
+
+def test_boundary_terms_added_into_the_stiffness_pattern_equal_the_sum():
+    """``add_into`` adds a matrix whose entries lie in K's pattern in K's own arrays (equal to
+    K + B entry for entry) and falls back to K + B when one does not."""
+    from rkfx.assembly.operators import add_into  # noqa: PLC0415
+
+    p = unit_square(0.1)
+    rk, dom = rk_approximation(p.x, p.spacing), nodal_domains(p)
+    k = stiffness(integration_rules("mscni", p, rk, dom), ElasticMaterial(2.0, 0.3).D())
+    rows = np.repeat(np.arange(k.shape[0]), np.diff(k.indptr))
+    pick = np.random.default_rng(1).choice(k.nnz, 50, replace=False)
+    inside = sp.coo_matrix((np.arange(1.0, 51.0), (rows[pick], k.indices[pick])), shape=k.shape)
+    expected = (k + inside).toarray()
+    got = add_into(k.copy(), inside)
+    assert np.array_equal(got.toarray(), expected)
+    summed = (k + inside).tocsr()  # the pattern of scipy's sum: exact zeros dropped
+    assert np.array_equal(got.indptr, summed.indptr) and np.array_equal(got.indices, summed.indices)
+    outside = sp.coo_matrix(([1.0], ([0], [k.shape[1] - 1])), shape=k.shape)
+    assert k[0, k.shape[1] - 1] == 0
+    assert np.array_equal(add_into(k.copy(), outside).toarray(), (k + outside).toarray())

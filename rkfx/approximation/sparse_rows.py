@@ -206,24 +206,29 @@ def stacked_rows(jobs: Iterable[RowJob], num_rows: int, slack: float = 1.25) -> 
 
 
 @numba.njit(parallel=True, cache=True)
-def _gather(indptr, indices, data, rows, out_ptr, out_idx, out_data):
+def _gather(indptr, indices, data, rows, column, out_ptr, out_idx, out_data):
+    renumber = len(column) > 0
     for r in numba.prange(len(rows)):
         src = indptr[rows[r]]
         for k in range(out_ptr[r + 1] - out_ptr[r]):
-            out_idx[out_ptr[r] + k] = indices[src + k]
+            j = indices[src + k]
+            out_idx[out_ptr[r] + k] = column[j] if renumber else j
             for c in range(data.shape[1]):
                 out_data[out_ptr[r] + k, c] = data[src + k, c]
 
 
-def gathered_rows(rows: SparseRows, which: np.ndarray) -> SparseRows:
-    """The rows ``which`` of ``rows``, in that order, each row's entries in their order."""
+def gathered_rows(rows: SparseRows, which: np.ndarray, column: np.ndarray | None = None,
+                  num_cols: int | None = None) -> SparseRows:
+    """The rows ``which`` of ``rows``, in that order, each row's entries in their order; with
+    ``column`` (new index of every column) over ``num_cols`` renumbered columns."""
     which = np.ascontiguousarray(which, dtype=np.int64)
     out_ptr = np.zeros(len(which) + 1, np.int64)
     np.cumsum(np.diff(rows.indptr)[which], out=out_ptr[1:])
     out_idx = np.empty(out_ptr[-1], np.int32)
     out_data = np.empty((out_ptr[-1], rows.num_components))
-    _gather(rows.indptr, rows.indices, np.ascontiguousarray(rows.data), which, out_ptr, out_idx, out_data)
-    return SparseRows(out_ptr, out_idx, out_data, rows.num_cols)
+    col = np.empty(0, np.int32) if column is None else np.ascontiguousarray(column, dtype=np.int32)
+    _gather(rows.indptr, rows.indices, np.ascontiguousarray(rows.data), which, col, out_ptr, out_idx, out_data)
+    return SparseRows(out_ptr, out_idx, out_data, rows.num_cols if num_cols is None else num_cols)
 
 
 def _grown(a: np.ndarray, used: int, capacity: int) -> np.ndarray:

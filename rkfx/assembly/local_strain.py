@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from rkfx.approximation.sparse_rows import SparseRows
+from rkfx.approximation.sparse_rows import SparseRows, gathered_rows
 from rkfx.assembly.smeared_strain import (SmearedStrain, StrainRecipe, cell_average, row_strains, subcell_load,
                                           transposed_force)
 from rkfx.errors import InputError
@@ -170,17 +170,6 @@ def _mark_columns(indptr, indices, rows, mark):
 
 
 @numba.njit(cache=True)
-def _copy_rows(indptr, indices, data, rows, column, out_indptr, out_indices, out_data):
-    k = 0
-    for i, r in enumerate(rows):
-        for e in range(indptr[r], indptr[r + 1]):
-            out_indices[k] = column[indices[e]]
-            out_data[k] = data[e]
-            k += 1
-        out_indptr[i + 1] = k
-
-
-@numba.njit(cache=True)
 def _copy_row(indptr, indices, data, r, column, fill, out_rows, out_data):
     for e in range(indptr[r], indptr[r + 1]):
         c = column[indices[e]]
@@ -199,18 +188,8 @@ def _copy_columns(indptr_a, indices_a, data_a, indptr_b, indices_b, data_b, colu
         _copy_row(indptr_b, indices_b, data_b, r, column, fill, out_rows, out_data)
 
 
-def _sliced_rows(rows: SparseRows, at: np.ndarray, column: np.ndarray, num_cols: int) -> SparseRows:
-    """The rows ``at`` of ``rows``, each row's entries in their order, columns renumbered by
-    ``column`` (the global to local index)."""
-    indptr = np.zeros(len(at) + 1, np.int64)
-    size = int(np.diff(rows.indptr)[at].sum())
-    indices, data = np.empty(size, np.int32), np.empty((size, *rows.data.shape[1:]))
-    _copy_rows(rows.indptr, rows.indices, rows.data, at, column.astype(np.int32), indptr, indices, data)
-    return SparseRows(indptr, indices, data, num_cols)
-
-
 def _renumbered_rows(rows: SparseRows, at: np.ndarray, column: np.ndarray, num_cols: int) -> SparseRows:
-    """``_sliced_rows`` of rows that hold entries in the rows ``at`` alone: their own arrays,
+    """``gathered_rows`` of rows that hold entries in the rows ``at`` alone: their own arrays,
     the columns renumbered in place (``rows`` is spent)."""
     counts = np.diff(rows.indptr)[at]
     if counts.sum() != rows.indices.size:
@@ -289,7 +268,8 @@ def local_smeared_strain(op: SmearedStrain | StrainRecipe, part: np.ndarray, com
     # The rows touching an owned node: the entries in owned columns, each node's in row order.
     trows, t_data, t_counts = _owned_columns(sources or [rows], mine, n)
     del sources
-    local_rows = (_renumbered_rows if spent else _sliced_rows)(rows, orows, node_of, len(nodes))
+    local_rows = _renumbered_rows(rows, orows, node_of, len(nodes)) if spent else \
+        gathered_rows(rows, orows, node_of, len(nodes))
     lrows, row_of = _numbering(orows, trows, part[row_point], rows.num_rows)
     t_indptr = np.zeros(len(mine) + 1, np.int64)
     np.cumsum(t_counts, out=t_indptr[1:])

@@ -17,7 +17,7 @@ from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.linalg.linear_solver import SOLVERS, linear_solver
 from rkfx.errors import InputError
 from rkfx.geometry.nodal_domains import NodalDomains, nodal_domains
-from rkfx.assembly.operators import load_vector, stiffness
+from rkfx.assembly.operators import add_into, load_vector, stiffness
 from rkfx.geometry.particles import Particles
 from rkfx.integration.quadrature import NODAL_RULES, integration_rules
 from rkfx.parallel.ownership import numbering
@@ -167,7 +167,7 @@ def elastic_terms(p: Particles, rk: RKApproximation, domains: NodalDomains, mate
     g, gv = transformation_constraints(p, rk, displacements, nodes=nodes)
     if bc_method == "nitsche":
         kn, fn = nitsche_terms(p, bq, d, displacements, nitsche_penalty)
-        k, f = k + kn, f + fn
+        k, f = add_into(k, kn), f + fn
     return k, f, g, gv
 
 
