@@ -93,3 +93,28 @@ def test_boundary_terms_added_into_the_stiffness_pattern_equal_the_sum():
     outside = sp.coo_matrix(([1.0], ([0], [k.shape[1] - 1])), shape=k.shape)
     assert k[0, k.shape[1] - 1] == 0
     assert np.array_equal(add_into(k.copy(), outside).toarray(), (k + outside).toarray())
+
+
+def test_compiled_darcy_matrix_is_the_matrix_product():
+    """``laplacian`` (compiled ``scalar_form``) equals sum_q w_q G^T k G from scipy products to
+    round-off, for a scalar, a tensor, and per-point scalars and tensors, over the MSCNI rules."""
+    from rkfx.assembly.operators import laplacian  # noqa: PLC0415
+
+    p = unit_square(0.08)
+    rk, dom = rk_approximation(p.x, p.spacing), nodal_domains(p)
+    quads = integration_rules("mscni", p, rk, dom)
+    rng = np.random.default_rng(5)
+    tensor = np.array([[2.0, 0.3], [0.3, 1.0]])
+    for k in (2.5, tensor, [rng.uniform(1, 2, len(q.weights)) for q in quads],
+              [rng.uniform(1, 2, (len(q.weights), 1, 1)) * tensor for q in quads]):
+        ks = k if isinstance(k, list) else [k] * len(quads)
+        expected = 0
+        for q, kq in zip(quads, ks):
+            kq = np.asarray(kq, float)
+            kk = np.broadcast_to(kq.reshape(-1, 1, 1) * np.eye(2) if kq.ndim < 2 else kq, (len(q.weights), 2, 2))
+            g = (q.gradients.matrix(0), q.gradients.matrix(1))
+            expected = expected + sum(g[a].T @ sp.diags(q.weights * kk[:, a, b]) @ g[b]
+                                      for a in range(2) for b in range(2))
+        got = laplacian(quads, k)
+        assert got.has_sorted_indices
+        assert abs(got - expected).max() <= 1e-13 * abs(expected).max()

@@ -1,12 +1,15 @@
-"""The elastic stiffness sum_q w_q B_q^T D_q B_q assembled straight into its CSR rows, compiled.
+"""Galerkin matrices sum_q w_q B_q^T D_q B_q assembled straight into their CSR rows, compiled:
+the elastic stiffness (``elastic_stiffness``) and the scalar forms sum_q w_q a_I^T M_q a_J of
+one-field operators, the Darcy matrix over gradient rows and the mass over value rows
+(``scalar_form``).
 
 A product of scipy matrices (B^T, then diag(w D), then B) forms intermediates several times
 the size of K: at 9 x 10^4 nodes with the MSCNI rows, 1.4 GB of transients for a K of 167 MB,
-and most of the assembly's time. Here each node I owns its two rows of K: one pass over the
+and most of the assembly's time. Here each node I owns its rows of K: one pass over the
 points q whose rows hold I (the transposed entries, in point order) counts the distinct
-nodes J they couple I to, a second pass adds the 2 x 2 blocks B_I(q)^T w_q D_q B_J(q) in
-place. Rows are independent, so they run in parallel, and every entry is summed in the same
-order (points ascending, then the entries of each point's row) on any number of threads. The
+nodes J they couple I to, a second pass adds the blocks a_I(q)^T w_q M_q a_J(q) in place.
+Rows are independent, so they run in parallel, and every entry is summed in the same order
+(points ascending, then the entries of each point's row) on any number of threads. The
 columns of each row come out sorted, and the transposed entries come from a counting sort:
 no sort of the whole entry list, no sort of K afterwards.
 
@@ -18,6 +21,7 @@ int64's bytes, the largest arrays of the assembly after the rows) while they fit
 B(g) of a gradient g = (g_x, g_y) is the Voigt strain matrix [[g_x, 0], [0, g_y], [g_y, g_x]].
 """
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numba
 import numpy as np
@@ -26,69 +30,176 @@ import scipy.sparse as sp
 from rkfx.approximation.sparse_rows import SparseRows, work_items
 
 
-@numba.njit(parallel=True, cache=True)
-def _stiffness(ptr_a, idx_a, grad_a, ptr_b, idx_b, grad_b, point_of, t_ptr, t_entry, weight, d, per_point,
-               num_nodes, nchunks, node_ptr, out_idx, out_data, fill):
-    """Count (``fill`` False: node_ptr[I + 1] = distinct J of row I) or fill the CSR of K, over
-    the points of rows A and then rows B (entry p >= len(idx_a) is entry p - len(idx_a) of B)."""
-    chunk = (num_nodes + nchunks - 1) // nchunks
+@numba.njit(inline="always")
+def _row(q, ptr_a, idx_a, val_a, ptr_b, idx_b, val_b):
+    """The row of point q: its pointer, indices and values arrays and its place in them."""
     m_a = len(ptr_a) - 1
-    nnz_a = len(idx_a)
+    if q < m_a:
+        return ptr_a, idx_a, val_a, q
+    return ptr_b, idx_b, val_b, q - m_a
+
+
+@numba.njit(inline="always")
+def _entry(p, val_a, val_b):
+    """Entry p of A's values, then of B's: its values array and its place in it."""
+    if p < len(val_a):
+        return val_a, p
+    return val_b, p - len(val_a)
+
+
+@numba.njit(parallel=True, cache=True)
+def _count(ptr_a, idx_a, val_a, ptr_b, idx_b, val_b, point_of, t_ptr, t_entry, num_nodes, nchunks, node_ptr):
+    """node_ptr[I + 1] = the distinct J that the points of I couple it to."""
+    chunk = (num_nodes + nchunks - 1) // nchunks
+    for c in numba.prange(nchunks):
+        stamp = np.full(num_nodes, -1, np.int64)
+        for i in range(c * chunk, min(num_nodes, (c + 1) * chunk)):
+            k = 0
+            for e_i in range(t_ptr[i], t_ptr[i + 1]):
+                ptr, idx, _, off = _row(point_of[t_entry[e_i]], ptr_a, idx_a, val_a, ptr_b, idx_b, val_b)
+                for e in range(ptr[off], ptr[off + 1]):
+                    if stamp[idx[e]] != i:
+                        stamp[idx[e]] = i
+                        k += 1
+            node_ptr[i + 1] = k
+
+
+@numba.njit(inline="always")
+def _columns(i, width, ptr_a, idx_a, val_a, ptr_b, idx_b, val_b, point_of, t_ptr, t_entry, stamp, slot):
+    """The columns J of row I, ascending (``width`` of them); slot[J] = rank of J among them."""
+    cols = np.empty(width, np.int64)
+    k = 0
+    for e_i in range(t_ptr[i], t_ptr[i + 1]):
+        ptr, idx, _, off = _row(point_of[t_entry[e_i]], ptr_a, idx_a, val_a, ptr_b, idx_b, val_b)
+        for e in range(ptr[off], ptr[off + 1]):
+            j = idx[e]
+            if stamp[j] != i:
+                stamp[j] = i
+                cols[k] = j
+                k += 1
+    cols.sort()
+    for s in range(width):
+        slot[cols[s]] = s
+    return cols
+
+
+@numba.njit(parallel=True, cache=True)
+def _elastic_fill(ptr_a, idx_a, grad_a, ptr_b, idx_b, grad_b, point_of, t_ptr, t_entry, weight, d, per_point,
+                  num_nodes, nchunks, node_ptr, out_idx, out_data):
+    """The 2 x 2 blocks sum_q B_I^T w_q D_q B_J of K's rows (interleaved unknowns)."""
+    chunk = (num_nodes + nchunks - 1) // nchunks
     for c in numba.prange(nchunks):
         stamp = np.full(num_nodes, -1, np.int64)
         slot = np.empty(num_nodes, np.int64)
         t = np.empty((2, 3))
         for i in range(c * chunk, min(num_nodes, (c + 1) * chunk)):
-            k = 0
-            width = node_ptr[i + 1] - node_ptr[i] if fill else 0
+            width = node_ptr[i + 1] - node_ptr[i]
             first = 4 * node_ptr[i]
-            if fill:  # the row's columns, ascending: slot[J] = rank of J among them
-                cols = np.empty(width, np.int64)
-                for e_i in range(t_ptr[i], t_ptr[i + 1]):
-                    q = point_of[t_entry[e_i]]
-                    ptr, idx, off = (ptr_a, idx_a, q) if q < m_a else (ptr_b, idx_b, q - m_a)
-                    for e in range(ptr[off], ptr[off + 1]):
-                        j = idx[e]
-                        if stamp[j] != i:
-                            stamp[j] = i
-                            cols[k] = j
-                            k += 1
-                cols.sort()
-                for s in range(width):
-                    j = cols[s]
-                    slot[j] = s
-                    for a in range(2):
-                        for b in range(2):
-                            pos = first + 2 * a * width + 2 * s + b
-                            out_idx[pos] = 2 * j + b
-                            out_data[pos] = 0.0
+            cols = _columns(i, width, ptr_a, idx_a, grad_a, ptr_b, idx_b, grad_b, point_of, t_ptr, t_entry, stamp, slot)
+            for s in range(width):
+                for a in range(2):
+                    for b in range(2):
+                        pos = first + 2 * a * width + 2 * s + b
+                        out_idx[pos] = 2 * cols[s] + b
+                        out_data[pos] = 0.0
             for e_i in range(t_ptr[i], t_ptr[i + 1]):
                 p = t_entry[e_i]
                 q = point_of[p]
-                ptr, idx, grad, off = (ptr_a, idx_a, grad_a, q) if q < m_a else (ptr_b, idx_b, grad_b, q - m_a)
-                if fill:
-                    # t = B_I^T (w D): 2 x 3.
-                    m = d[q] if per_point else d[0]
-                    pe = p if p < nnz_a else p - nnz_a
-                    gx, gy, w = grad[pe, 0], grad[pe, 1], weight[q]
-                    for s in range(3):
-                        t[0, s] = w * (gx * m[0, s] + gy * m[2, s])
-                        t[1, s] = w * (gy * m[1, s] + gx * m[2, s])
+                ptr, idx, grad, off = _row(q, ptr_a, idx_a, grad_a, ptr_b, idx_b, grad_b)
+                # t = B_I^T (w D): 2 x 3.
+                m = d[q] if per_point else d[0]
+                gi, pe = _entry(p, grad_a, grad_b)
+                gx, gy, w = gi[pe, 0], gi[pe, 1], weight[q]
+                for s in range(3):
+                    t[0, s] = w * (gx * m[0, s] + gy * m[2, s])
+                    t[1, s] = w * (gy * m[1, s] + gx * m[2, s])
                 for e in range(ptr[off], ptr[off + 1]):
-                    j = idx[e]
-                    if not fill:
-                        if stamp[j] != i:
-                            stamp[j] = i
-                            k += 1
-                    else:
-                        hx, hy = grad[e, 0], grad[e, 1]
-                        base = first + 2 * slot[j]
-                        for a in range(2):
-                            row = base + 2 * a * width
-                            out_data[row] += t[a, 0] * hx + t[a, 2] * hy
-                            out_data[row + 1] += t[a, 1] * hy + t[a, 2] * hx
-            if not fill:
-                node_ptr[i + 1] = k
+                    hx, hy = grad[e, 0], grad[e, 1]
+                    base = first + 2 * slot[idx[e]]
+                    for a in range(2):
+                        row = base + 2 * a * width
+                        out_data[row] += t[a, 0] * hx + t[a, 2] * hy
+                        out_data[row + 1] += t[a, 1] * hy + t[a, 2] * hx
+
+
+@numba.njit(parallel=True, cache=True)
+def _scalar_fill(ptr_a, idx_a, val_a, ptr_b, idx_b, val_b, point_of, t_ptr, t_entry, weight, metric, per_point,
+                 num_nodes, nchunks, node_ptr, out_idx, out_data):
+    """The entries sum_q w_q a_I(q)^T M_q a_J(q) of the rows of a one-field matrix."""
+    chunk = (num_nodes + nchunks - 1) // nchunks
+    nc = val_a.shape[1]
+    for c in numba.prange(nchunks):
+        stamp = np.full(num_nodes, -1, np.int64)
+        slot = np.empty(num_nodes, np.int64)
+        t = np.empty(nc)
+        for i in range(c * chunk, min(num_nodes, (c + 1) * chunk)):
+            width = node_ptr[i + 1] - node_ptr[i]
+            first = node_ptr[i]
+            cols = _columns(i, width, ptr_a, idx_a, val_a, ptr_b, idx_b, val_b, point_of, t_ptr, t_entry, stamp, slot)
+            for s in range(width):
+                out_idx[first + s] = cols[s]
+                out_data[first + s] = 0.0
+            for e_i in range(t_ptr[i], t_ptr[i + 1]):
+                p = t_entry[e_i]
+                q = point_of[p]
+                ptr, idx, val, off = _row(q, ptr_a, idx_a, val_a, ptr_b, idx_b, val_b)
+                m = metric[q] if per_point else metric[0]
+                vi, pe = _entry(p, val_a, val_b)
+                w = weight[q]
+                for b in range(nc):  # t = w a_I^T M
+                    acc = 0.0
+                    for a in range(nc):
+                        acc += vi[pe, a] * m[a, b]
+                    t[b] = w * acc
+                for e in range(ptr[off], ptr[off + 1]):
+                    acc = 0.0
+                    for b in range(nc):
+                        acc += t[b] * val[e, b]
+                    out_data[first + slot[idx[e]]] += acc
+
+
+@dataclass(frozen=True)
+class _Points:
+    """The rows of the points in at most two sets (A, then B), their transposed entries and
+    the point of each entry: what both fills read."""
+
+    a: SparseRows
+    b: SparseRows
+    point_of: np.ndarray
+    t_ptr: np.ndarray
+    t_entry: np.ndarray
+
+    @property
+    def num_nodes(self) -> int:
+        return self.a.num_cols
+
+    @property
+    def rows(self) -> tuple:
+        return (self.a.indptr, np.ascontiguousarray(self.a.indices), _values(self.a), self.b.indptr,
+                np.ascontiguousarray(self.b.indices), _values(self.b))
+
+    def pattern(self) -> np.ndarray:
+        """node_ptr: the row pointer of the nodes' rows (one entry per coupled node)."""
+        n = self.num_nodes
+        node_ptr = np.zeros(n + 1, np.int64)
+        _count(*self.rows, self.point_of, self.t_ptr, self.t_entry, n, work_items(n), node_ptr)
+        np.cumsum(node_ptr, out=node_ptr)
+        return node_ptr
+
+
+def _points(rows: SparseRows | Sequence[SparseRows]) -> _Points:
+    parts = [rows] if isinstance(rows, SparseRows) else list(rows)
+    if len(parts) > 2:  # the kernels read two sets where they are; more are joined into the second
+        parts = [parts[0], _joined(parts[1:])]
+    a = parts[0]
+    b = parts[1] if len(parts) > 1 else SparseRows(np.zeros(1, np.int64), a.indices[:0], a.data[:0], a.num_cols)
+    n = a.num_cols
+    nnz = a.indices.size + b.indices.size
+    index = np.int32 if max(nnz, a.num_rows + b.num_rows) < 2**31 else np.int64
+    t_ptr = np.zeros(n + 1, np.int64)
+    np.cumsum(np.bincount(a.indices, minlength=n) + np.bincount(b.indices, minlength=n), out=t_ptr[1:])
+    return _Points(a, b, _entry_points(a.indptr, b.indptr, np.empty(nnz, index)), t_ptr,
+                   _transposed_entries(a.indices, b.indices, t_ptr, np.empty(nnz, index)))
 
 
 def elastic_stiffness(rows: SparseRows | Sequence[SparseRows], weights: np.ndarray, d: np.ndarray) -> sp.csr_matrix:
@@ -100,30 +211,15 @@ def elastic_stiffness(rows: SparseRows | Sequence[SparseRows], weights: np.ndarr
         weights: w_q, shape ``(m,)`` [m^2].
         d: D [Pa], shape ``(3, 3)`` or one per point ``(m, 3, 3)``.
     """
-    parts = [rows] if isinstance(rows, SparseRows) else list(rows)
-    if len(parts) > 2:  # the kernel reads two sets where they are; more are joined into the second
-        parts = [parts[0], _joined(parts[1:])]
-    a = parts[0]
-    b = parts[1] if len(parts) > 1 else SparseRows(np.zeros(1, np.int64), a.indices[:0], a.data[:0], a.num_cols)
-    n = a.num_cols
-    m = a.num_rows + b.num_rows
-    nnz = a.indices.size + b.indices.size
-    index = np.int32 if max(nnz, m) < 2**31 else np.int64
+    pts = _points(rows)
+    n = pts.num_nodes
     d = np.ascontiguousarray(d, dtype=np.float64)
     per_point = d.ndim == 3
-    d = d if per_point else d.reshape(1, 3, 3)
-    t_ptr = np.zeros(n + 1, np.int64)
-    np.cumsum(np.bincount(a.indices, minlength=n) + np.bincount(b.indices, minlength=n), out=t_ptr[1:])
-    t_entry = _transposed_entries(a.indices, b.indices, t_ptr, np.empty(nnz, index))
-    point_of = _entry_points(a.indptr, b.indptr, np.empty(nnz, index))
-    args = (a.indptr, np.ascontiguousarray(a.indices), _grad(a), b.indptr, np.ascontiguousarray(b.indices), _grad(b),
-            point_of, t_ptr, t_entry, np.ascontiguousarray(weights, dtype=np.float64), d, per_point, n, work_items(n))
-    node_ptr = np.zeros(n + 1, np.int64)
-    _stiffness(*args, node_ptr, np.empty(0, np.int32), np.empty(0), False)
-    np.cumsum(node_ptr, out=node_ptr)
+    node_ptr = pts.pattern()
     out_idx = np.empty(4 * node_ptr[-1], np.int32)
     out_data = np.empty(4 * node_ptr[-1])
-    _stiffness(*args, node_ptr, out_idx, out_data, True)
+    _elastic_fill(*pts.rows, pts.point_of, pts.t_ptr, pts.t_entry, np.ascontiguousarray(weights, dtype=np.float64),
+                  d if per_point else d.reshape(1, 3, 3), per_point, n, work_items(n), node_ptr, out_idx, out_data)
     indptr = np.empty(2 * n + 1, np.int64)
     indptr[0:-1:2] = 4 * node_ptr[:-1]
     indptr[1::2] = 4 * node_ptr[:-1] + 2 * np.diff(node_ptr)
@@ -133,7 +229,36 @@ def elastic_stiffness(rows: SparseRows | Sequence[SparseRows], weights: np.ndarr
     return k
 
 
-def _grad(rows: SparseRows) -> np.ndarray:
+def scalar_form(rows: SparseRows | Sequence[SparseRows], weights: np.ndarray, metric: np.ndarray) -> sp.csr_matrix:
+    """A = sum_q w_q a_I(q)^T M_q a_J(q), shape ``(n, n)``, sorted indices: the Darcy matrix
+    over gradient rows (M the permeability, c = 2) or the mass over value rows (M a scalar
+    coefficient, c = 1).
+
+    Args:
+        rows: Rows a_I(x_q) with c components, shape ``(m, n)``, or a list of such rows whose
+            points follow each other.
+        weights: w_q, shape ``(m,)``.
+        metric: M, shape ``(c, c)`` or one per point ``(m, c, c)``.
+    """
+    pts = _points(rows)
+    n = pts.num_nodes
+    nc = pts.a.num_components
+    metric = np.ascontiguousarray(metric, dtype=np.float64)
+    per_point = metric.ndim == 3
+    if metric.shape[-2:] != (nc, nc):
+        raise ValueError(f"metric of shape {metric.shape} for rows of {nc} components")
+    node_ptr = pts.pattern()
+    out_idx = np.empty(node_ptr[-1], np.int32)
+    out_data = np.empty(node_ptr[-1])
+    _scalar_fill(*pts.rows, pts.point_of, pts.t_ptr, pts.t_entry, np.ascontiguousarray(weights, dtype=np.float64),
+                 metric if per_point else metric.reshape(1, nc, nc), per_point, n, work_items(n), node_ptr, out_idx,
+                 out_data)
+    a = sp.csr_matrix((out_data, out_idx, node_ptr), shape=(n, n))
+    a.has_sorted_indices = True
+    return a
+
+
+def _values(rows: SparseRows) -> np.ndarray:
     return np.ascontiguousarray(rows.data, dtype=np.float64)
 
 

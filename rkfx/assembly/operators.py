@@ -8,7 +8,7 @@ import numba
 import numpy as np
 import scipy.sparse as sp
 
-from rkfx.assembly.galerkin import elastic_stiffness
+from rkfx.assembly.galerkin import elastic_stiffness, scalar_form
 from rkfx.errors import InputError
 from rkfx.integration.quadrature import Quadrature
 from rkfx.approximation.sparse_rows import SparseRows
@@ -95,39 +95,32 @@ def add_into(a: sp.csr_matrix, b: sp.spmatrix) -> sp.csr_matrix:
 
 
 def laplacian(quadratures: list[Quadrature], k=1.0) -> sp.csr_matrix:
-    """Diffusion matrix ``sum_q w_q (grad N)^T k grad N`` (eqs. 3.35 and 3.59), shape ``(n, n)``.
+    """Diffusion matrix ``sum_q w_q (grad N)^T k grad N`` (eqs. 3.35 and 3.59), shape ``(n, n)``,
+    compiled (``rkfx.assembly.galerkin.scalar_form``).
 
     ``k``: a scalar or ``(2, 2)`` tensor, or a list with a ``(m_q,)`` or ``(m_q, 2, 2)`` array
     per quadrature (an isotropic or anisotropic permeability per point).
     """
-    total = None
+    metrics = []
     for q, kq in zip(quadratures, _per_quadrature(k, quadratures)):
-        g = q.gradients
-        gx, gy = g.matrix(0), g.matrix(1)
         kq = np.asarray(kq, float)
         m = len(q.weights)
         if kq.ndim == 0 or kq.shape == (m,):
-            kk = (kq.reshape(-1, 1, 1) if kq.ndim else kq) * np.eye(2)
-        else:
-            kk = kq
-        kk = np.broadcast_to(kk, (m, 2, 2))
-        grads = (gx, gy)
-        term = None
-        for a in range(2):
-            for b in range(2):
-                if not np.any(kk[:, a, b]):
-                    continue
-                part = grads[a].T @ sp.diags(q.weights * kk[:, a, b]) @ grads[b]
-                term = part if term is None else term + part
-        term = term if term is not None else sp.csr_matrix((g.num_cols, g.num_cols))
-        total = term if total is None else total + term
-    return total.tocsr()
+            kq = (kq.reshape(-1, 1, 1) if kq.ndim else kq) * np.eye(2)
+        metrics.append(np.broadcast_to(kq, (m, 2, 2)) if kq.ndim == 3 else kq)
+    a = _form([q.gradients for q in quadratures], quadratures, metrics)
+    a.eliminate_zeros()  # as scipy's sums did (no entries that are exactly zero for the solvers)
+    return a
 
 
 def mass(quadratures: list[Quadrature], c=1.0) -> sp.csr_matrix:
     """``sum_q w_q c N^T N`` over the value rows (eqs. 3.34 and 3.58), shape ``(n, n)``.
 
     ``c``: a scalar, or a list with a ``(m_q,)`` array per quadrature.
+
+    One scipy product per quadrature: the value rows are short, and at 263k nodes (MSCNI) the
+    product takes 0.61 s where the compiled ``scalar_form`` takes 0.9-1.2 s (its cost is per
+    (node, point, node) triple, as for ``laplacian``, which it makes 1.7 times faster).
     """
     total = None
     for q, cq in zip(quadratures, _per_quadrature(c, quadratures)):
@@ -137,6 +130,17 @@ def mass(quadratures: list[Quadrature], c=1.0) -> sp.csr_matrix:
         term = nmat.T @ sp.diags(np.asarray(cq, float) * q.weights) @ nmat
         total = term if total is None else total + term
     return total.tocsr()
+
+
+def _form(rows: list[SparseRows], quadratures: list[Quadrature], metrics: list[np.ndarray]) -> sp.csr_matrix:
+    """``scalar_form`` over the points of all the quadratures, with one metric (``(c, c)``) or
+    one per point (``(m_q, c, c)``) for each."""
+    if all(mq.ndim == 2 and np.array_equal(mq, metrics[0]) for mq in metrics):
+        metric = metrics[0]
+    else:
+        c = metrics[0].shape[-1]
+        metric = np.concatenate([np.broadcast_to(mq, (len(q.weights), c, c)) for q, mq in zip(quadratures, metrics)])
+    return scalar_form(rows, np.concatenate([q.weights for q in quadratures]), metric)
 
 
 def load_vector(values: SparseRows, weights: np.ndarray, f: np.ndarray) -> np.ndarray:
