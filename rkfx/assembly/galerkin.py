@@ -40,11 +40,15 @@ def _row(q, ptr_a, idx_a, val_a, ptr_b, idx_b, val_b):
 
 
 @numba.njit(inline="always")
-def _entry(p, val_a, val_b):
-    """Entry p of A's values, then of B's: its values array and its place in it."""
+def _term(e_i, t_entry, point_of, ptr_a, idx_a, val_a, ptr_b, idx_b, val_b):
+    """Transposed entry e_i: its point q, the row of q (pointer, indices, values, place) and
+    the values array of the entry itself with its place in it (A's entries, then B's)."""
+    p = t_entry[e_i]
+    q = point_of[p]
+    ptr, idx, val, off = _row(q, ptr_a, idx_a, val_a, ptr_b, idx_b, val_b)
     if p < len(val_a):
-        return val_a, p
-    return val_b, p - len(val_a)
+        return q, ptr, idx, val, off, val_a, p
+    return q, ptr, idx, val, off, val_b, p - len(val_a)
 
 
 @numba.njit(parallel=True, cache=True)
@@ -103,12 +107,10 @@ def _elastic_fill(ptr_a, idx_a, grad_a, ptr_b, idx_b, grad_b, point_of, t_ptr, t
                         out_idx[pos] = 2 * cols[s] + b
                         out_data[pos] = 0.0
             for e_i in range(t_ptr[i], t_ptr[i + 1]):
-                p = t_entry[e_i]
-                q = point_of[p]
-                ptr, idx, grad, off = _row(q, ptr_a, idx_a, grad_a, ptr_b, idx_b, grad_b)
+                q, ptr, idx, grad, off, gi, pe = _term(e_i, t_entry, point_of, ptr_a, idx_a, grad_a, ptr_b, idx_b,
+                                                       grad_b)
                 # t = B_I^T (w D): 2 x 3.
                 m = d[q] if per_point else d[0]
-                gi, pe = _entry(p, grad_a, grad_b)
                 gx, gy, w = gi[pe, 0], gi[pe, 1], weight[q]
                 for s in range(3):
                     t[0, s] = w * (gx * m[0, s] + gy * m[2, s])
@@ -140,11 +142,8 @@ def _scalar_fill(ptr_a, idx_a, val_a, ptr_b, idx_b, val_b, point_of, t_ptr, t_en
                 out_idx[first + s] = cols[s]
                 out_data[first + s] = 0.0
             for e_i in range(t_ptr[i], t_ptr[i + 1]):
-                p = t_entry[e_i]
-                q = point_of[p]
-                ptr, idx, val, off = _row(q, ptr_a, idx_a, val_a, ptr_b, idx_b, val_b)
+                q, ptr, idx, val, off, vi, pe = _term(e_i, t_entry, point_of, ptr_a, idx_a, val_a, ptr_b, idx_b, val_b)
                 m = metric[q] if per_point else metric[0]
-                vi, pe = _entry(p, val_a, val_b)
                 w = weight[q]
                 for b in range(nc):  # t = w a_I^T M
                     acc = 0.0
