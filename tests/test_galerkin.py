@@ -118,3 +118,22 @@ def test_compiled_darcy_matrix_is_the_matrix_product():
         got = laplacian(quads, k)
         assert got.has_sorted_indices
         assert abs(got - expected).max() <= 1e-13 * abs(expected).max()
+
+
+def test_mscni_stiffness_is_the_subcell_rule_stiffness():
+    """At eps_p = 1 the MSCNI stiffness A_L B_L^T D B_L + sum_C A_C (B_L - B_C)^T D (B_L - B_C)
+    is sum_C A_C B_C^T D B_C (the subcells partition each cell), on median-dual and grid cells;
+    the elastic model assembles it so."""
+    from rkfx.geometry.grid_cells import grid_domains  # noqa: PLC0415
+    from rkfx.geometry.particles import graded  # noqa: PLC0415
+    from rkfx.integration.quadrature import subcell_rule  # noqa: PLC0415
+
+    d = ElasticMaterial(2.0, 0.3).D()
+    p = unit_square(0.08)
+    xs, ys = np.linspace(0.0, 1.0, 13), np.linspace(0.0, 0.5, 7) ** 1.2
+    g = graded(xs, ys)
+    for pts, dom in ((p, nodal_domains(p)), (g, grid_domains(xs, ys))):
+        rk = rk_approximation(pts.x, pts.spacing)
+        mscni = stiffness(integration_rules("mscni", pts, rk, dom), d)
+        sub = stiffness([subcell_rule(rk, dom)], d)
+        assert abs(mscni - sub).max() <= 1e-13 * abs(mscni).max()

@@ -218,8 +218,8 @@ def _cells_and_subcells(rk: RKApproximation, d: NodalDomains, nodes: np.ndarray,
     return cell, diff.rows()
 
 
-def subcell_gradients(rk: RKApproximation, domains: NodalDomains, nodes: np.ndarray | None = None
-                      ) -> tuple[SparseRows, SparseRows, np.ndarray]:
+def subcell_gradients(rk: RKApproximation, domains: NodalDomains, nodes: np.ndarray | None = None,
+                      with_cells: bool = True) -> tuple[SparseRows | None, SparseRows, np.ndarray]:
     """The smoothed gradients of eq. (3.55) over each cell, grad~N_I(x_L), and over each of
     its subcells, grad~N_I(x_hat_C) (the subcell rows of eq. 3.56), from one evaluation of N
     at the smoothing points.
@@ -231,7 +231,8 @@ def subcell_gradients(rk: RKApproximation, domains: NodalDomains, nodes: np.ndar
 
     Returns:
         (cell rows, subcell rows, order): subcell row k belongs to subcell ``order[k]`` of
-        ``domains``; the rows are grouped by particle (stable sort of ``subcell_node``).
+        ``domains``; the rows are grouped by particle (stable sort of ``subcell_node``). The
+        cell rows are ``None`` without ``with_cells``.
     """
     d = domains
     order = np.argsort(d.subcell_node, kind="stable")
@@ -261,10 +262,22 @@ def subcell_gradients(rk: RKApproximation, domains: NodalDomains, nodes: np.ndar
         at_points = evaluate(rk, d.smoothing_points[used])
         local = position[d.cell_point], position[d.subcell_point[order].ravel()]
     cell = combine_rows(at_points, cell_ptr, local[0][cell_terms],
-                        (d.cell_normal_length / np.repeat(d.area, cell_length)[:, None])[cell_terms])
+                        (d.cell_normal_length / np.repeat(d.area, cell_length)[:, None])[cell_terms]) \
+        if with_cells else None
     sub = combine_rows(at_points, sub_ptr, local[1][sub_terms],
                        (d.subcell_normal_length[order] / d.subcell_area[order, None, None]).reshape(-1, 2)[sub_terms])
     return cell, sub, order
+
+
+def subcell_rule(rk: RKApproximation, domains: NodalDomains, nodes: np.ndarray | None = None) -> Quadrature:
+    """The subcells as points: weights A_C, the gradients smoothed over each subcell
+    grad~N_I(x_hat_C) (``subcell_gradients``; with ``nodes``, only those nodes' subcells hold
+    entries). Over a grad-grad form it is MSCNI at eps_p = 1: the subcells partition each cell
+    (sum_C A_C B_C = A_L B_L, sum_C A_C = A_L), so eq. (3.56) gives
+    A_L B_L^T D B_L + sum_C A_C (B_L - B_C)^T D (B_L - B_C) = sum_C A_C B_C^T D B_C,
+    from fewer and shorter rows."""
+    _, sub, order = subcell_gradients(rk, domains, nodes=nodes, with_cells=False)
+    return Quadrature(domains.subcell_centroid[order], domains.subcell_area[order], None, sub, "subcells")
 
 
 def scni(p: Particles, rk: RKApproximation, domains: NodalDomains,

@@ -19,7 +19,7 @@ from rkfx.errors import InputError
 from rkfx.geometry.nodal_domains import NodalDomains, nodal_domains
 from rkfx.assembly.operators import add_into, load_vector, stiffness
 from rkfx.geometry.particles import Particles
-from rkfx.integration.quadrature import NODAL_RULES, integration_rules
+from rkfx.integration.quadrature import NODAL_RULES, integration_rules, scni, subcell_rule
 from rkfx.parallel.ownership import numbering
 from rkfx.parallel.partition import rcb
 from rkfx.parallel.rows import owned_block, owned_entries, renumbered
@@ -156,8 +156,12 @@ def elastic_terms(p: Particles, rk: RKApproximation, domains: NodalDomains, mate
     summed over a partition's parts (and G stacked) are the whole ones.
     """
     d = material.D()
-    quads = integration_rules(rule, p, rk, domains, nodes=nodes)
-    k = stiffness(quads, d)
+    if rule == "mscni":  # its stiffness is the subcell rule's (eps_p = 1; subcell_rule)
+        k = stiffness([subcell_rule(rk, domains, nodes=nodes)], d)
+        quads = [scni(p, rk, domains, nodes=nodes)] if body_force is not None else []
+    else:
+        quads = integration_rules(rule, p, rk, domains, nodes=nodes)
+        k = stiffness(quads, d)
     segments = None if nodes is None else np.flatnonzero(np.isin(domains.boundary.node, nodes))
     bq = boundary_quadrature(p, domains, rk, segments=segments)
     f = traction_load(p, bq, tractions)
