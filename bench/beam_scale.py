@@ -32,9 +32,11 @@ def run_one(nx: int, ny: int, solver: str, support: float) -> dict:
 
     from rkfx.approximation.shape_functions import evaluate  # noqa: PLC0415
     from rkfx.models.elastostatics import solve_plane_strain  # noqa: PLC0415
+    from rkfx.memory import reuse_freed_memory  # noqa: PLC0415
     from rkfx.warmup import warm_up  # noqa: PLC0415
     from verification.timoshenko_beam import TimoshenkoBeam  # noqa: PLC0415
 
+    reuse_freed_memory()
     warm_up()
     beam = TimoshenkoBeam()
     p = beam.nodes(nx, ny)

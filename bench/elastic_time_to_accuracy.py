@@ -29,6 +29,7 @@ from fem_baselines.poroelasticity import rectangle_mesh
 from rkfx.cases import plate_with_hole
 from rkfx.integration.norms import relative_errors
 from rkfx.models.elastostatics import solve_plane_strain
+from rkfx.memory import reuse_freed_memory
 from rkfx.warmup import warm_up
 from verification.timoshenko_beam import TimoshenkoBeam
 
@@ -108,6 +109,7 @@ def main(argv=None) -> None:
     ap.add_argument("--plate-levels", type=int, default=4, help="levels of the plate with a hole (0: skip)")
     ap.add_argument("--beam-grids", default="33x9,65x17,129x33,257x65", help="nx x ny grids of the beam ('': skip)")
     args = ap.parse_args(argv)
+    reuse_freed_memory()  # large temporaries reuse freed pages (rkfx.memory)
     warm_up()
     beam_runs([(9, 3)])  # compile the kernels and forms before timing
     if args.plate_levels:

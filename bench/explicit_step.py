@@ -70,8 +70,10 @@ def main(argv=None):
     ap.add_argument("--steps", type=int, default=20, help="steps timed per size")
     ap.add_argument("--courant", type=float, default=0.5, help="C of dt = C min(h) / c_d")
     args = ap.parse_args(argv)
+    from rkfx.memory import reuse_freed_memory
     from rkfx.warmup import warm_up
 
+    reuse_freed_memory()  # large temporaries reuse freed pages (rkfx.memory)
     warm_up()
     measure(400, 3, args.courant)  # compile the step kernels
     rows = [measure(int(n), args.steps, args.courant) for n in sorted(args.nodes)]

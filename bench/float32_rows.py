@@ -118,8 +118,10 @@ def main(argv=None):
     ap.add_argument("--kalthoff", nargs="*", type=int, default=[250], help="Kalthoff particles per side")
     ap.add_argument("--t-end", type=float, default=80e-6, help="Kalthoff end time [s]")
     args = ap.parse_args(argv)
+    from rkfx.memory import reuse_freed_memory  # noqa: PLC0415
     from rkfx.warmup import warm_up  # noqa: PLC0415
 
+    reuse_freed_memory()  # large temporaries reuse freed pages (rkfx.memory)
     warm_up()
     for grid in args.beam:
         nx, ny = (int(v) for v in grid.split("x"))

@@ -17,6 +17,7 @@ import numpy as np
 
 from rkfx.cases import injection as case
 from rkfx.models import hydraulic_fracture as hf
+from rkfx.memory import reuse_freed_memory
 from rkfx.warmup import warm_up
 
 
@@ -27,6 +28,7 @@ def main() -> None:
     ap.add_argument("--dt", type=float, default=50.0, help="time step [s]")
     ap.add_argument("--jacobian", default="full", choices=hf.JACOBIANS)
     args = ap.parse_args()
+    reuse_freed_memory()  # large temporaries reuse freed pages (rkfx.memory)
     warm_up()
     spent = {"residual": 0.0, "tangent": 0.0, "capacity": 0.0}
     for name in spent:

@@ -40,8 +40,10 @@ def main(argv=None):
     from rkfx.cases import _dynamic_fracture as dyn
     from rkfx.cases import kalthoff as k
     from rkfx.models.damage_dynamics import DamageForce, damage_field
+    from rkfx.memory import reuse_freed_memory
     from rkfx.warmup import warm_up
 
+    reuse_freed_memory()  # large temporaries reuse freed pages (rkfx.memory)
     warm_up()
     k.run(methods=("rkpm",), h=k.spacings([40]), unregularized_h=[], no_tracking_h=[], fem_h=[],
           t_end=5e-6)  # compile the step kernels

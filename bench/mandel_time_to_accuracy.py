@@ -22,6 +22,7 @@ from rkfx.conditions import Displacement, Pressure, split
 from rkfx.geometry.particles import structured
 from rkfx.models.poroelasticity import PoroMaterial, solve_biot
 from rkfx.solvers.integrate import time_grid
+from rkfx.memory import reuse_freed_memory
 from rkfx.warmup import warm_up
 from verification.mandel import Mandel
 
@@ -61,6 +62,7 @@ def main(argv=None):
     x = np.linspace(0.0, LX, 401)
     p_exact = np.array([exact.pressure(x, t) for t in outputs])
     bcs = conditions(exact)
+    reuse_freed_memory()  # large temporaries reuse freed pages (rkfx.memory)
     warm_up()
     for solve in (rkpm, taylor_hood):  # compile forms / kernels outside the timings
         solve(11, 3, material, bcs, times[:3], times[2:3], x)

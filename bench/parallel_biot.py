@@ -24,6 +24,7 @@ from rkfx.conditions import Displacement, Pressure
 from rkfx.geometry.particles import structured
 from rkfx.models.poroelasticity import PoroMaterial, solve_biot
 from rkfx.solvers.integrate import time_grid
+from rkfx.memory import reuse_freed_memory
 from rkfx.warmup import warm_up
 from verification.mandel import Mandel
 
@@ -36,6 +37,7 @@ def main() -> None:
     ap.add_argument("--compare", help="report the relative difference to these saved coefficients")
     args = ap.parse_args()
     comm = MPI.COMM_WORLD
+    reuse_freed_memory()  # large temporaries reuse freed pages (rkfx.memory)
     warm_up()
     material = PoroMaterial(1.0e4, 0.2, 1.0e-4)
     exact = Mandel(material.E, material.nu, material.k, 20.0, 2.0, 40.0)

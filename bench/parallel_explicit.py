@@ -26,6 +26,7 @@ from rkfx.cases import _dynamic_fracture as dyn
 from rkfx.cases import kalthoff as k
 from rkfx.fracture import damage as dm
 from rkfx.parallel.threads import share_cores
+from rkfx.memory import reuse_freed_memory
 from rkfx.warmup import warm_up
 
 
@@ -39,6 +40,7 @@ def main() -> None:
     comm = MPI.COMM_WORLD
     if comm.size > 1:
         share_cores(comm)
+    reuse_freed_memory()  # large temporaries reuse freed pages (rkfx.memory)
     warm_up()
     k.run(methods=("rkpm",), h=k.spacings([40]), unregularized_h=[], no_tracking_h=[], fem_h=[],
           t_end=5e-6)  # compile the step kernels

@@ -48,6 +48,7 @@ from rkfx.cases._terminal import _fmt_value, model_run, progress, step_progress,
 from rkfx.errors import InputError, SolverError
 from rkfx.parallel.threads import share_cores
 from rkfx.solvers.checkpoint import has_checkpoint, run_folder
+from rkfx.memory import reuse_freed_memory
 from rkfx.warmup import warm_up
 
 VTK_FOLDER = "vtk"  # OUT/vtk: the ParaView files of --vtk
@@ -334,6 +335,7 @@ def main(name: str, doc: str | None, specs: Mapping[str, Param], run: Callable[.
         world = comm()
         if world is not None and world.size > 1:
             share_cores(world)  # ranks x threads <= cores
+        reuse_freed_memory()  # large temporaries reuse freed pages (rkfx.memory)
         warm_up()  # wall times below measure the methods, not the JIT compiler
         try:
             results = run(methods=METHODS[args.method], **params, **extra)
