@@ -86,7 +86,7 @@ def test_domains_around_some_nodes_give_their_cells_as_the_whole_build():
 @pytest.mark.parametrize("nodes", [None, "some"])
 def test_smoothed_gradients_in_blocks_of_points_equal_one_block(monkeypatch, nodes):
     """N is evaluated a block of smoothing points at a time (``POINTS_PER_BLOCK``); the cell
-    rows, MSCNI rows and their order are the same bit for bit as from one block."""
+    rows, MSCNI rows, subcell rows and their order are the same bit for bit as from one block."""
     from rkfx.approximation.shape_functions import rk_approximation  # noqa: PLC0415
     import rkfx.integration.quadrature as quadrature  # noqa: PLC0415
 
@@ -95,10 +95,14 @@ def test_smoothed_gradients_in_blocks_of_points_equal_one_block(monkeypatch, nod
     d = nodal_domains(p)
     sel = None if nodes is None else np.arange(3, p.num_nodes, 2)
     one = quadrature.smoothed_gradients(p, rk, d, nodes=sel)
+    one_sub = quadrature.subcell_gradients(rk, d, nodes=sel)
     monkeypatch.setattr(quadrature, "POINTS_PER_BLOCK", 37)
     many = quadrature.smoothed_gradients(p, rk, d, nodes=sel)
+    many_sub = quadrature.subcell_gradients(rk, d, nodes=sel)
     assert np.array_equal(one.subcells, many.subcells)
-    for x, y in ((one.cell, many.cell), (one.cell_minus_subcell, many.cell_minus_subcell)):
+    assert np.array_equal(one_sub[2], many_sub[2])
+    for x, y in ((one.cell, many.cell), (one.cell_minus_subcell, many.cell_minus_subcell),
+                 (one_sub[0], many_sub[0]), (one_sub[1], many_sub[1])):
         assert x.num_rows > 0
         for name in ("indptr", "indices", "data"):
             assert np.array_equal(getattr(x, name), getattr(y, name)), name

@@ -231,6 +231,16 @@ def gathered_rows(rows: SparseRows, which: np.ndarray, column: np.ndarray | None
     return SparseRows(out_ptr, out_idx, out_data, rows.num_cols if num_cols is None else num_cols)
 
 
+def spread_rows(rows: SparseRows, at: np.ndarray, num_rows: int) -> SparseRows:
+    """``rows`` placed as the rows ``at`` (ascending) of ``num_rows`` rows, the others empty
+    (the same entry arrays)."""
+    lengths = np.zeros(num_rows, np.int64)
+    lengths[at] = np.diff(rows.indptr)
+    indptr = np.zeros(num_rows + 1, np.int64)
+    np.cumsum(lengths, out=indptr[1:])
+    return SparseRows(indptr, rows.indices, rows.data, rows.num_cols)
+
+
 def _grown(a: np.ndarray, used: int, capacity: int) -> np.ndarray:
     """A buffer of ``capacity`` rows holding the first ``used`` rows of ``a`` (the rest unwritten)."""
     out = np.empty((capacity, *a.shape[1:]), a.dtype)

@@ -38,7 +38,7 @@ from rkfx.geometry.particles import Particles
 from rkfx.integration.quadrature import smoothed_gradients, subcell_gradients
 from rkfx.approximation.shape_functions import RKApproximation
 from rkfx.solvers.central_difference import Constraint
-from rkfx.approximation.sparse_rows import SparseRows
+from rkfx.approximation.sparse_rows import SparseRows, spread_rows
 
 
 @numba.njit(parallel=True, cache=True)
@@ -311,7 +311,7 @@ def smeared_strain(p: Particles, rk: RKApproximation, domains: NodalDomains | No
         if points is None:
             cell = smoothed_gradients(p, rk, domains, subcells=False).cell
         else:
-            cell = _spread(smoothed_gradients(p, rk, domains, subcells=False, nodes=points).cell, points,
+            cell = spread_rows(smoothed_gradients(p, rk, domains, subcells=False, nodes=points).cell, points,
                            p.num_nodes)
         op = SmearedStrain(cell, volume)
         if points is None:
@@ -368,15 +368,6 @@ class StrainRecipe:
     def share(self, part: np.ndarray, rank: int) -> SmearedStrain:
         """The rows of ``near``, each other row left empty in its place."""
         return self.build(self.near(part, rank))
-
-
-def _spread(rows: SparseRows, at: np.ndarray, num_rows: int) -> SparseRows:
-    """``rows`` placed as the rows ``at`` (ascending) of ``num_rows`` rows, the others empty."""
-    lengths = np.zeros(num_rows, np.int64)
-    lengths[at] = np.diff(rows.indptr)
-    indptr = np.zeros(num_rows + 1, np.int64)
-    np.cumsum(lengths, out=indptr[1:])
-    return SparseRows(indptr, rows.indices, rows.data, rows.num_cols)
 
 
 def near_part(x: np.ndarray, part: np.ndarray, rank: int, margin: float) -> np.ndarray:

@@ -19,8 +19,8 @@ from rkfx.errors import InputError
 from rkfx.geometry.nodal_domains import NodalDomains
 from rkfx.geometry.particles import Particles
 from rkfx.approximation.shape_functions import RKApproximation, evaluate
-from rkfx.approximation.sparse_rows import (RowStack, SparseRows, combine_job, combine_rows, difference_rows,
-                                           gathered_rows, stacked_rows)
+from rkfx.approximation.sparse_rows import (RowStack, SparseRows, combine_job, difference_rows, gathered_rows,
+                                           spread_rows, stacked_rows)
 
 # Symmetric Gauss rules on the reference triangle: barycentric points and weights (sum 1).
 _TRIANGLE_RULES = {
@@ -180,10 +180,11 @@ def _cell_blocks(rk: RKApproximation, d: NodalDomains, nodes: np.ndarray, slot: 
         yield combine_job(evaluate(rk, d.smoothing_points[points]), ptr, local, weight)
 
 
-def _cells_and_subcells(rk: RKApproximation, d: NodalDomains, nodes: np.ndarray, sub: np.ndarray, slot: np.ndarray
-                        ) -> tuple[SparseRows, SparseRows]:
-    """The cell rows of ``nodes`` and the MSCNI rows grad~N(x_L) - grad~N(x_hat_C) of their
-    subcells ``sub`` (eqs. 3.55-3.56), a block of subcells at a time.
+def _cells_and_subcells(rk: RKApproximation, d: NodalDomains, nodes: np.ndarray, sub: np.ndarray, slot: np.ndarray,
+                        difference: bool = True) -> tuple[SparseRows, SparseRows]:
+    """The cell rows of ``nodes`` and the rows of their subcells ``sub`` (in that order), a
+    block of subcells at a time: the MSCNI rows grad~N(x_L) - grad~N(x_hat_C) (eq. 3.56), or
+    without ``difference`` the subcell gradients grad~N(x_hat_C) themselves.
 
     A block evaluates N once, at its subcells' sides and at the cell boundaries of the nodes
     whose cell rows it is the first to need (a cell's boundary segments are sides of its
@@ -192,7 +193,7 @@ def _cells_and_subcells(rk: RKApproximation, d: NodalDomains, nodes: np.ndarray,
     """
     owner = d.subcell_node[sub]
     where = np.full(len(d.area), -1, np.int64)  # row of each node's cell among those formed
-    cells, diff = RowStack(len(nodes)), RowStack(len(sub))
+    cells, subs = RowStack(len(nodes)), RowStack(len(sub))
     for lo, hi in _block_bounds(np.full(len(sub), 4), POINTS_PER_BLOCK):
         block = sub[lo:hi]
         new = np.unique(owner[lo:hi])
@@ -202,9 +203,11 @@ def _cells_and_subcells(rk: RKApproximation, d: NodalDomains, nodes: np.ndarray,
         at = evaluate(rk, d.smoothing_points[points])
         where[new] = cells.count + np.arange(len(new))
         cells.append(combine_job(at, ptr, local[:len(terms)], weight))
-        diff.append(combine_job(at, np.arange(0, 4 * len(block) + 1, 4), local[len(terms):],
-                                (-d.subcell_normal_length[block] / d.subcell_area[block, None, None]).reshape(-1, 2),
-                                base=cells.rows(), base_row=where[owner[lo:hi]]))
+        side_weight = (d.subcell_normal_length[block] / d.subcell_area[block, None, None]).reshape(-1, 2)
+        sides = np.arange(0, 4 * len(block) + 1, 4)
+        subs.append(combine_job(at, sides, local[len(terms):], -side_weight, base=cells.rows(),
+                                base_row=where[owner[lo:hi]]) if difference else
+                    combine_job(at, sides, local[len(terms):], side_weight))
         del at
     rest = nodes[where[nodes] < 0]  # cells without subcells
     if rest.size:
@@ -215,14 +218,14 @@ def _cells_and_subcells(rk: RKApproximation, d: NodalDomains, nodes: np.ndarray,
     cell = cells.rows()
     if not np.array_equal(order, np.arange(len(nodes))):
         cell = gathered_rows(cell, order)
-    return cell, diff.rows()
+    return cell, subs.rows()
 
 
-def subcell_gradients(rk: RKApproximation, domains: NodalDomains, nodes: np.ndarray | None = None,
-                      with_cells: bool = True) -> tuple[SparseRows | None, SparseRows, np.ndarray]:
+def subcell_gradients(rk: RKApproximation, domains: NodalDomains, nodes: np.ndarray | None = None
+                      ) -> tuple[SparseRows, SparseRows, np.ndarray]:
     """The smoothed gradients of eq. (3.55) over each cell, grad~N_I(x_L), and over each of
-    its subcells, grad~N_I(x_hat_C) (the subcell rows of eq. 3.56), from one evaluation of N
-    at the smoothing points.
+    its subcells, grad~N_I(x_hat_C) (the subcell rows of eq. 3.56), a block of subcells at a
+    time (``POINTS_PER_BLOCK``).
 
     ``nodes`` (ascending indices) fills only the rows of those particles' cells and subcells,
     evaluating N only at their smoothing points; the other rows stay empty, so the rows keep
@@ -231,42 +234,20 @@ def subcell_gradients(rk: RKApproximation, domains: NodalDomains, nodes: np.ndar
 
     Returns:
         (cell rows, subcell rows, order): subcell row k belongs to subcell ``order[k]`` of
-        ``domains``; the rows are grouped by particle (stable sort of ``subcell_node``). The
-        cell rows are ``None`` without ``with_cells``.
+        ``domains``; the rows are grouped by particle (stable sort of ``subcell_node``).
     """
     d = domains
     order = np.argsort(d.subcell_node, kind="stable")
-    ns = len(order)
-    cell_length = np.diff(d.cell_ptr)
+    slot = np.full(len(d.smoothing_points), -1, np.int32)
     if nodes is None:
-        at_points = evaluate(rk, d.smoothing_points)
-        cell_ptr, cell_terms, sub_ptr, sub_terms = d.cell_ptr, np.arange(len(d.cell_point)), \
-            np.arange(0, 4 * ns + 1, 4), np.arange(4 * ns)
-        local = d.cell_point, d.subcell_point[order].ravel()
-    else:
-        mine = np.zeros(len(d.area), bool)
-        mine[nodes] = True
-        cell_ptr = np.zeros(len(d.area) + 1, np.int64)
-        np.cumsum(np.where(mine, cell_length, 0), out=cell_ptr[1:])
-        cell_terms = np.flatnonzero(np.repeat(mine, cell_length))
-        sub_mine = mine[d.subcell_node[order]]
-        sub_ptr = np.zeros(ns + 1, np.int64)
-        np.cumsum(np.where(sub_mine, 4, 0), out=sub_ptr[1:])
-        sub_terms = np.flatnonzero(np.repeat(sub_mine, 4))
-        keep = np.zeros(len(d.smoothing_points), bool)
-        keep[d.cell_point[cell_terms]] = True
-        keep[d.subcell_point[order].ravel()[sub_terms]] = True
-        used = np.flatnonzero(keep)
-        position = np.full(len(keep), -1, np.int64)
-        position[used] = np.arange(len(used))
-        at_points = evaluate(rk, d.smoothing_points[used])
-        local = position[d.cell_point], position[d.subcell_point[order].ravel()]
-    cell = combine_rows(at_points, cell_ptr, local[0][cell_terms],
-                        (d.cell_normal_length / np.repeat(d.area, cell_length)[:, None])[cell_terms]) \
-        if with_cells else None
-    sub = combine_rows(at_points, sub_ptr, local[1][sub_terms],
-                       (d.subcell_normal_length[order] / d.subcell_area[order, None, None]).reshape(-1, 2)[sub_terms])
-    return cell, sub, order
+        cell, sub = _cells_and_subcells(rk, d, np.arange(len(d.area)), order, slot, difference=False)
+        return cell, sub, order
+    nodes = np.asarray(nodes, dtype=np.int64)
+    mine = np.zeros(len(d.area), bool)
+    mine[nodes] = True
+    filled = np.flatnonzero(mine[d.subcell_node[order]])  # places of the selected subcells' rows
+    cell, sub = _cells_and_subcells(rk, d, nodes, order[filled], slot, difference=False)
+    return spread_rows(cell, nodes, len(d.area)), spread_rows(sub, filled, len(order)), order
 
 
 def subcell_rule(rk: RKApproximation, domains: NodalDomains, nodes: np.ndarray | None = None) -> Quadrature:
@@ -276,7 +257,7 @@ def subcell_rule(rk: RKApproximation, domains: NodalDomains, nodes: np.ndarray |
     (sum_C A_C B_C = A_L B_L, sum_C A_C = A_L), so eq. (3.56) gives
     A_L B_L^T D B_L + sum_C A_C (B_L - B_C)^T D (B_L - B_C) = sum_C A_C B_C^T D B_C,
     from fewer and shorter rows."""
-    _, sub, order = subcell_gradients(rk, domains, nodes=nodes, with_cells=False)
+    _, sub, order = subcell_gradients(rk, domains, nodes=nodes)
     return Quadrature(domains.subcell_centroid[order], domains.subcell_area[order], None, sub, "subcells")
 
 
