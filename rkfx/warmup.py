@@ -18,6 +18,7 @@ def warm_up() -> None:
     from rkfx.models.damage_dynamics import run_damage
     from rkfx.geometry.nodal_domains import nodal_domains
     from rkfx.assembly.operators import stiffness
+    from rkfx.linalg.symmetry import is_symmetric
     from rkfx.geometry.particles import structured
     from rkfx.integration.quadrature import integration_rules, mscni_stabilization, smoothed_gradients
     from rkfx.approximation.shape_functions import evaluate, rk_approximation
@@ -30,7 +31,8 @@ def warm_up() -> None:
     rk = rk_approximation(p.x, p.spacing)
     s = smoothed_gradients(p, rk, d)
     mscni_stabilization(p, rk, d, s, with_values=True)
-    stiffness(integration_rules("dni", p, rk, d), ElasticMaterial(1.0, 0.3).D())
+    k = stiffness(integration_rules("dni", p, rk, d), ElasticMaterial(1.0, 0.3).D())
+    is_symmetric(k)
     crack = cracks([np.array([[0.0, 0.4], [0.5, 0.4]])])
     evaluate(rk_approximation(p.x, p.spacing, 1.75, cracks=crack), p.x, gradients=True)
     model = damage_model(DamageMaterial(1.0, 0.3, 1e-3, 1e-3), d.area, geometry=cell_geometry(p))

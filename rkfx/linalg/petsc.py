@@ -18,6 +18,7 @@ from petsc4py import PETSc
 
 from rkfx.errors import InputError, SolverError
 from rkfx.linalg.linear_solver import SOLVERS
+from rkfx.linalg.symmetry import is_symmetric
 
 # Relative residual at which the Krylov solvers stop. CG + GAMG stops at 1e-8: on Timoshenko's
 # beam (bench/beam_scale.py, 263k nodes) the displacement error is the same to three digits
@@ -109,8 +110,12 @@ def gather(vec: PETSc.Vec) -> np.ndarray:
 
 
 def make_ksp(mat: PETSc.Mat, solver: str = "mumps", rtol: float | None = None, prefix: str = "rkfx_",
-             mumps_icntl: Mapping[int, int] | None = None, coordinates: np.ndarray | None = None) -> PETSc.KSP:
+             mumps_icntl: Mapping[int, int] | None = None, coordinates: np.ndarray | None = None,
+             symmetric: bool = False) -> PETSc.KSP:
     """A KSP for ``mat``: MUMPS LU (default), GMRES with ILU/ASM, or CG with GAMG.
+
+    ``symmetric`` (mumps): ``mat`` equals its transpose, and MUMPS factorizes it as L D L^T
+    with pivoting (its symmetric indefinite mode), from the upper triangle only.
 
     ``mumps_icntl`` sets further MUMPS controls, e.g. ``{7: 2}`` for the AMF ordering.
     ``coordinates`` (cg-gamg on a 2-D displacement system, unknowns interleaved per node): the
@@ -129,7 +134,9 @@ def make_ksp(mat: PETSc.Mat, solver: str = "mumps", rtol: float | None = None, p
     pc = ksp.getPC()
     if solver == "mumps":
         ksp.setType("preonly")
-        pc.setType("lu")
+        if symmetric:
+            mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        pc.setType("cholesky" if symmetric else "lu")
         pc.setFactorSolverType("mumps")
         pc.setFactorSetUpSolverType()
         # Saddle-point systems (multiplier constraints, u-p coupling) delay pivots: give MUMPS
@@ -192,7 +199,10 @@ class LinearSolver:
         else:
             self.pattern = (a.shape, a.indptr.copy(), a.indices.copy())
             self.mat = to_petsc_mat(a, comm)
-        self.ksp = make_ksp(self.mat, solver, mumps_icntl=mumps_icntl, coordinates=coordinates)
+        # A symmetric matrix (whole on every rank) is factorized as L D L^T: half the work of LU.
+        self.symmetric = solver == "mumps" and not owned_rows and is_symmetric(a)
+        self.ksp = make_ksp(self.mat, solver, mumps_icntl=mumps_icntl, coordinates=coordinates,
+                            symmetric=self.symmetric)
         self.rhs = self.mat.createVecLeft()
         self.x = self.mat.createVecRight()
         self.residual = self.mat.createVecLeft()
@@ -246,7 +256,8 @@ class LinearSolver:
             return False
         a = _sorted_csr(a)
         shape, indptr, indices = self.pattern
-        return a.shape == shape and np.array_equal(a.indptr, indptr) and np.array_equal(a.indices, indices)
+        return (a.shape == shape and np.array_equal(a.indptr, indptr) and np.array_equal(a.indices, indices)
+                and (not self.symmetric or is_symmetric(a)))
 
     def refactor(self, a: sp.spmatrix) -> None:
         """Take the values of ``a`` (same pattern): the next solve factorizes anew, reusing the

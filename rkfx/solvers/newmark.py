@@ -270,6 +270,7 @@ class _NewmarkSystem:
         self.M, self.C = model.mass(), model.capacity(co.dt)
         self.G, self.Gw = plan.G, plan.scaled_rows(co)
         self.W = equation_weights(model, co)
+        self.cw = _constraint_weights(self.G, self.Gw, self.W)
         self.linear = plan.linear
         on_explicit = plan.on_explicit
         if on_explicit.any():
@@ -311,7 +312,8 @@ class _NewmarkSystem:
         self.scale = max(self.norm(t) for t in terms)
         if self.W is not None:
             r = self.W * r
-        return np.r_[r, self.c0 + self.Gw @ z[:self.n]]
+        c = self.c0 + self.Gw @ z[:self.n]
+        return np.r_[r, c if self.cw is None else self.cw * c]
 
     def jacobian(self, z):
         co = self.co
@@ -330,7 +332,8 @@ class _NewmarkSystem:
         if k == 0:
             j = j.tocsr()
         else:  # all blocks CSR: scipy stacks them without converting to COO
-            j = sp.bmat([[sp.csr_matrix(j), sp.csr_matrix(gt)], [sp.csr_matrix(self.Gw), sp.csr_matrix((k, k))]],
+            gw = self.Gw if self.cw is None else _scale_rows(self.Gw, self.cw)
+            j = sp.bmat([[sp.csr_matrix(j), sp.csr_matrix(gt)], [sp.csr_matrix(gw), sp.csr_matrix((k, k))]],
                         format="csr")
         return j if self.share is None else row_system(j, self.share, k, self.share.comm)
 
@@ -341,7 +344,7 @@ class _NewmarkSystem:
         st = self.stepper
         if iteration < st.min_iterations:
             return False
-        eq, con = r[:self.n], r[self.n:]
+        eq, con = r[:self.n], r[self.n:] if self.cw is None else r[self.n:] / self.cw
         if self.r0 is None:
             self.r0 = self.norm(eq)
         # Relative to the start and to the size of the terms at this iterate, so that
@@ -349,6 +352,31 @@ class _NewmarkSystem:
         ok_eq = self.norm(eq) <= st.atol + st.rtol * max(self.r0, self.scale)
         ok_con = self.norm(con) <= st.ctol * self.gscale
         return bool(ok_eq and ok_con)
+
+
+def _constraint_weights(G: sp.csr_matrix, Gw: sp.csr_matrix, W: np.ndarray | None) -> np.ndarray | None:
+    """Weights s_k of the constraint rows that make the step Jacobian symmetric when the model
+    weights its equations for that (``W``): s_k Gw_kj = -W_j G_kj over row k, so that the
+    constraint rows are the transpose of the -W G^T columns. A row whose entries ask for
+    different s_k keeps 1 (that Jacobian is not symmetric). ``None`` without ``W``."""
+    k = G.shape[0]
+    if W is None or k == 0:
+        return None
+    g, gw = sp.csr_matrix(G), sp.csr_matrix(Gw)
+    s = np.ones(k)
+    if not (np.array_equal(g.indptr, gw.indptr) and np.array_equal(g.indices, gw.indices)):
+        return s
+    nonzero = gw.data != 0
+    ratio = np.where(nonzero, -W[g.indices] * g.data / np.where(nonzero, gw.data, 1.0), np.nan)
+    filled = np.flatnonzero(np.diff(g.indptr) > 0)
+    if filled.size == 0:
+        return s
+    starts = g.indptr[filled]
+    lo = np.fmin.reduceat(ratio, starts)
+    hi = np.fmax.reduceat(ratio, starts)
+    uniform = np.isfinite(lo) & (hi - lo <= 1e-12 * np.abs(hi)) & (lo != 0)
+    s[filled[uniform]] = lo[uniform]
+    return s
 
 
 def _scale_columns(a: sp.csr_matrix, scale: np.ndarray) -> sp.csr_matrix:
