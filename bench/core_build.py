@@ -2,14 +2,16 @@
 
 For each size, in a fresh process (so peak memory is that size's own):
   nodal domains (median-dual cells and subcells)                 -> ``domains``
-  N at every smoothing point, combined into the cell smoothed gradients (3.55) and, in the
-  same pass, the MSCNI rows grad~N(x_L) - grad~N(x_C) (3.56); N at the nodes (value rows
-  for coupling and storage terms)                                  -> ``operators``
+  the rows every model integrates with (``rkfx.integration.quadrature.mscni_rules``): N at
+  the smoothing points a block at a time, combined into the cell smoothed gradients (3.55)
+  and, in the same pass, the subcell gradients grad~N(x_hat_C) of the MSCNI terms (3.56);
+  N at the nodes; with ``--with-values`` also the value rows N(x_L) - N(x_hat_C) of the u-p
+  storage and projection terms (3.58)                              -> ``operators``
 The node set (a uniform grid and its triangulation) is input, not timed. Numba kernels are
 compiled before timing. For reference, dolfinx assembles the P1 plane-strain stiffness on a
 mesh with the same number of vertices (``fem_baselines.assembly_timing``).
 
-Usage: python bench/core_build.py [--nodes 1e4 1e5 1e6] [--no-fem]
+Usage: python bench/core_build.py [--nodes 1e4 1e5 1e6] [--no-fem] [--with-values]
 The last line printed reads ``<N> nodes: <seconds> s`` for the largest N.
 """
 import argparse
@@ -20,12 +22,12 @@ import sys
 import time
 
 
-def build(num_nodes: int) -> dict:
+def build(num_nodes: int, with_values: bool = False) -> dict:
     import numpy as np
 
     from rkfx.geometry.nodal_domains import nodal_domains
     from rkfx.geometry.particles import structured
-    from rkfx.integration.quadrature import mscni_stabilization, smoothed_gradients
+    from rkfx.integration.quadrature import mscni_rules
     from rkfx.approximation.shape_functions import rk_approximation
 
     def once(n):
@@ -37,11 +39,11 @@ def build(num_nodes: int) -> dict:
         d = nodal_domains(p)
         t["domains"] = time.perf_counter() - t0
         t0 = time.perf_counter()
-        s = smoothed_gradients(p, rk, d, subcells=True)
-        stab = mscni_stabilization(p, rk, d, s)
+        nodal, rules, values = mscni_rules(p, rk, d, with_values=with_values)
         t["operators"] = time.perf_counter() - t0
-        points = len(d.smoothing_points) + p.num_nodes
-        nnz = s.cell.indices.size + s.node_values.indices.size + stab.gradients.indices.size
+        points = len(d.smoothing_points) + p.num_nodes + (len(d.subcell_area) if with_values else 0)
+        rows = [nodal.gradients, nodal.values, rules[-1].gradients] + ([values.values] if with_values else [])
+        nnz = sum(r.indices.size for r in rows)
         return p.num_nodes, points, nnz, t
 
     once(400)  # compile / load cached kernels
@@ -61,16 +63,18 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--nodes", nargs="+", type=float, default=[1e4, 1e5, 1e6])
     ap.add_argument("--no-fem", action="store_true", help="skip the dolfinx reference")
+    ap.add_argument("--with-values", action="store_true", help="also the MSCNI value rows of the u-p models")
     ap.add_argument("--worker", choices=["rk", "fem"], help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.worker:
-        out = build(int(args.nodes[0])) if args.worker == "rk" else fem(int(args.nodes[0]))
+        out = build(int(args.nodes[0]), args.with_values) if args.worker == "rk" else fem(int(args.nodes[0]))
         print(json.dumps(out))
         return
     rows = []
     for n in sorted(int(v) for v in args.nodes):
         def run(kind):
-            r = subprocess.run([sys.executable, __file__, "--worker", kind, "--nodes", str(n)],
+            r = subprocess.run([sys.executable, __file__, "--worker", kind, "--nodes", str(n)]
+                               + ["--with-values"] * args.with_values,
                                capture_output=True, text=True)
             if r.returncode:
                 sys.exit(f"benchmark worker ({kind}, {n} nodes) failed:\n{r.stderr[-2000:]}")

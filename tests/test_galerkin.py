@@ -1,6 +1,7 @@
 """The compiled stiffness is the product B^T diag(w D) B, entry for entry to round-off, for
 constant and per-point D, over one or several quadratures, the same on any number of threads."""
 import numba
+import pytest
 import numpy as np
 import scipy.sparse as sp
 
@@ -137,3 +138,29 @@ def test_mscni_stiffness_is_the_subcell_rule_stiffness():
         mscni = stiffness(integration_rules("mscni", pts, rk, dom), d)
         sub = stiffness([subcell_rule(rk, dom)], d)
         assert abs(mscni - sub).max() <= 1e-13 * abs(mscni).max()
+
+
+@pytest.mark.parametrize("eps_p", [1.0, 0.5])
+def test_mscni_rules_give_the_mscni_forms(eps_p):
+    """``mscni_rules`` (SCNI weighted 1 - eps_p and the subcell gradients weighted eps_p A_C)
+    give eq. (3.56)'s stiffness and eq. (3.59)'s Darcy matrix with a per-particle field, and
+    eq. (3.58)'s value rows, as the difference rows of ``mscni_stabilization`` give them."""
+    from rkfx.assembly.operators import laplacian, mass  # noqa: PLC0415
+    from rkfx.integration.quadrature import mscni_rules, mscni_stabilization, scni, smoothed_gradients  # noqa: PLC0415
+
+    p = unit_square(0.08)
+    rk = rk_approximation(p.x, p.spacing)
+    dom = nodal_domains(p)
+    s = smoothed_gradients(p, rk, dom)
+    old = [scni(p, rk, dom, s), mscni_stabilization(p, rk, dom, s, eps_p, with_values=True)]
+    nodal, rules, values = mscni_rules(p, rk, dom, eps_p)
+    k_node = 1.0 + np.random.default_rng(0).uniform(size=p.num_nodes)  # a permeability per particle
+    owners = {"scni": np.arange(p.num_nodes), "mscni-stabilization": dom.subcell_node,
+              "mscni-subcells": dom.subcell_node}
+    d = ElasticMaterial(2.0, 0.3).D()
+    for a, b in ((stiffness(old, d), stiffness(rules, d)),
+                 (laplacian(old, [k_node[owners[q.name]] for q in old]),
+                  laplacian(rules, [k_node[owners[q.name]] for q in rules])),
+                 (mass(old), mass([nodal, values]))):
+        assert abs(a - b).max() <= 1e-12 * abs(a).max()
+    assert len(rules) == (1 if eps_p == 1.0 else 2)

@@ -44,14 +44,15 @@ class Quadrature:
         points: Shape ``(num_points, 2)`` [m] (for stabilization rows: the subcell centroids).
         weights: Shape ``(num_points,)`` [m^2].
         values: Rows with entries [N_I], or ``None`` where a rule has no value part.
-        gradients: Rows with entries [N_I,x, N_I,y] [1/m] (direct or smoothed).
+        gradients: Rows with entries [N_I,x, N_I,y] [1/m] (direct or smoothed), or ``None``
+            where a rule has no gradient part.
         name: Rule name, for reports.
     """
 
     points: np.ndarray
     weights: np.ndarray
     values: SparseRows | None
-    gradients: SparseRows
+    gradients: SparseRows | None
     name: str
 
 
@@ -259,6 +260,49 @@ def subcell_rule(rk: RKApproximation, domains: NodalDomains, nodes: np.ndarray |
     from fewer and shorter rows."""
     _, sub, order = subcell_gradients(rk, domains, nodes=nodes)
     return Quadrature(domains.subcell_centroid[order], domains.subcell_area[order], None, sub, "subcells")
+
+
+def mscni_rules(p: Particles, rk: RKApproximation, domains: NodalDomains, eps_p: float = 1.0,
+                nodes: np.ndarray | None = None, with_values: bool = True
+                ) -> tuple[Quadrature, list[Quadrature], Quadrature | None]:
+    """MSCNI (eqs. 3.55-3.59) over the cells of ``nodes`` (default all) and their subcells (in
+    index order), from one evaluation of N per block of subcells (``_cells_and_subcells``).
+
+    Returns ``(nodal, gradient_rules, values)``:
+        nodal: SCNI, points x_L, weights A_L, values N(x_L), cell gradients grad~N(x_L).
+        gradient_rules: the quadratures of every grad-grad form (stiffness, Darcy): since the
+            subcells partition each cell (sum_C A_C B_C = A_L B_L), eq. (3.56)
+            A_L B_L^T D B_L + eps_p sum_C A_C (B_L - B_C)^T D (B_L - B_C)
+            = (1 - eps_p) A_L B_L^T D B_L + eps_p sum_C A_C B_C^T D B_C, with D the cell's:
+            SCNI weighted (1 - eps_p) (left out at eps_p = 1) and the subcells weighted
+            eps_p A_C with their gradients grad~N(x_hat_C).
+        values: the value rows N(x_L) - N(x_hat_C) of eq. (3.58) at the subcells, weights
+            eps_p A_C (no gradients); ``None`` without ``with_values``.
+    """
+    if not eps_p >= 0:
+        raise InputError(f"eps_p = {eps_p!r} must be >= 0 (1 is the usual MSCNI choice)")
+    d = domains
+    if nodes is None:
+        nodes, sub = np.arange(len(d.area)), np.arange(len(d.subcell_area))
+    else:
+        nodes = np.asarray(nodes, dtype=np.int64)
+        mine = np.zeros(len(d.area), bool)
+        mine[nodes] = True
+        sub = np.flatnonzero(mine[d.subcell_node])
+    cell, grads = _cells_and_subcells(rk, d, nodes, sub, np.full(len(d.smoothing_points), -1, np.int32),
+                                      difference=False)
+    node_values = evaluate(rk, p.x[nodes])
+    nodal = Quadrature(p.x[nodes], d.area[nodes], node_values, cell, "scni")
+    centroids, weights = d.subcell_centroid[sub], eps_p * d.subcell_area[sub]
+    rules = [Quadrature(centroids, weights, None, grads, "mscni-subcells")]
+    if eps_p != 1.0:
+        rules.insert(0, Quadrature(nodal.points, (1.0 - eps_p) * nodal.weights, None, cell, "scni"))
+    if not with_values:
+        return nodal, rules, None
+    row_of = np.full(len(d.area), -1, np.int64)
+    row_of[nodes] = np.arange(len(nodes))
+    values = difference_rows(node_values, row_of[d.subcell_node[sub]], evaluate(rk, centroids))
+    return nodal, rules, Quadrature(centroids, weights, values, None, "mscni-values")
 
 
 def scni(p: Particles, rk: RKApproximation, domains: NodalDomains,

@@ -30,7 +30,7 @@ Pre-existing cracks (a notch) enter as particles damaged from the start (``initi
 D = 1 with their crack normal, fluid pressure prescribed on them by a ``Region`` condition.
 """
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -295,7 +295,10 @@ class HydraulicFractureModel:
         if self._k_stab is None or self._k_stab[0] is not self.committed:
             it = self.integration
             frac = self._stiffness_fraction(self.committed.damage)
-            self._k_stab = (self.committed, stiffness(it.quads[1:], [frac[it.owners[1]][:, None, None] * self._C]))
+            # MSCNI's grad-grad quadratures less plain SCNI: the subcell terms alone.
+            quads = [*it.gradient_quads, replace(self.nodal, weights=-self.nodal.weights)]
+            owners = [*it.gradient_owners, it.nodes]
+            self._k_stab = (self.committed, stiffness(quads, [frac[o][:, None, None] * self._C for o in owners]))
         return self._k_stab[1]
 
     def _split(self, x):
@@ -313,7 +316,7 @@ class HydraulicFractureModel:
         f_int = self._bt @ (self.volume[:, None] * stress).ravel() + self._stabilization() @ u
         alpha = self.rock.biot(st.damage)
         self._coupling = (self._div.T @ sp.diags(alpha * self.volume) @ self._values).tocsr()
-        self._kh = laplacian(it.quads, it.at_points(self.permeability(st, eps), None))
+        self._kh = laplacian(it.gradient_quads, it.at_points(self.permeability(st, eps), None, gradients=True))
         self._P = P
         f_ext, q_ext = self._loads(t)
         return np.r_[f_int - self._coupling @ P - f_ext, self._kh @ P - q_ext]
@@ -361,7 +364,7 @@ class HydraulicFractureModel:
         t = np.column_stack([-_unit(st.normal)[:, 1], _unit(st.normal)[:, 0]])
         total = None
         it = self.integration
-        for q, owner in zip(it.quads, it.owners):
+        for q, owner in zip(it.gradient_quads, it.gradient_owners):
             gx, gy = q.gradients.matrix(0), q.gradients.matrix(1)
             g = np.column_stack([gx @ self._P, gy @ self._P])
             tq = t[owner]

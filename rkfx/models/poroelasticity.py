@@ -42,7 +42,7 @@ from rkfx.errors import InputError
 from rkfx.geometry.nodal_domains import NodalDomains, nodal_domains
 from rkfx.assembly.operators import laplacian, mass, stiffness
 from rkfx.geometry.particles import Particles
-from rkfx.integration.quadrature import Quadrature, dni, mscni_stabilization, scni, smoothed_gradients
+from rkfx.integration.quadrature import Quadrature, dni, mscni_rules, scni
 from rkfx.approximation.shape_functions import RKApproximation, evaluate, rk_approximation
 from rkfx.parallel.ownership import numbering
 from rkfx.parallel.partition import rcb
@@ -196,8 +196,12 @@ class BiotIntegration:
 
     Attributes:
         nodal: The nodal points (SCNI or DNI) of the integrated nodes.
-        quads: ``[nodal]``, or ``[nodal, subcells]`` with the MSCNI subcell terms (3.56)-(3.59).
-        owners: The particle whose fields apply at each point of each quadrature.
+        quads: The quadratures of the value forms (storage, projection): ``[nodal]``, or
+            ``[nodal, subcells]`` with the MSCNI value rows N(x_L) - N(x_hat_C) (3.58).
+        owners: The particle whose fields apply at each point of each of ``quads``.
+        gradient_quads: The quadratures of the grad-grad forms (stiffness, Darcy): ``[nodal]``,
+            or MSCNI's (3.56), (3.59) as SCNI and subcell gradients (``mscni_rules``).
+        gradient_owners: The particle whose fields apply at each point of each of those.
         nodes: The integrated nodes (ascending).
         subcells: Indices of the integrated subcells, or ``None`` for all of them.
     """
@@ -205,12 +209,16 @@ class BiotIntegration:
     nodal: Quadrature
     quads: list[Quadrature]
     owners: list[np.ndarray]
+    gradient_quads: list[Quadrature]
+    gradient_owners: list[np.ndarray]
     nodes: np.ndarray
     subcells: np.ndarray | None
 
-    def at_points(self, value, constant):
-        """A per-particle field at the points of every quadrature (``constant`` where ``None``)."""
-        return constant if value is None else [np.asarray(value, float)[o] for o in self.owners]
+    def at_points(self, value, constant, gradients: bool = False):
+        """A per-particle field at the points of every quadrature of the value forms (of the
+        grad-grad forms with ``gradients``); ``constant`` where ``value`` is ``None``."""
+        owners = self.gradient_owners if gradients else self.owners
+        return constant if value is None else [np.asarray(value, float)[o] for o in owners]
 
 
 def biot_integration(p: Particles, rk: RKApproximation, domains: NodalDomains, variant: str = "scni+fpp",
@@ -221,14 +229,14 @@ def biot_integration(p: Particles, rk: RKApproximation, domains: NodalDomains, v
     d = domains
     mine = np.arange(p.num_nodes) if nodes is None else np.asarray(nodes, np.int64)
     if variant.startswith("scni"):
-        smoothed = smoothed_gradients(p, rk, d, subcells=True, nodes=nodes)
-        nodal = scni(p, rk, d, smoothed)
-        stab = mscni_stabilization(p, rk, d, smoothed, eps_p, with_values=True)
-        return BiotIntegration(nodal, [nodal, stab], [mine, d.subcell_node[smoothed.subcells]], mine,
-                               smoothed.subcells)
+        nodal, rules, values = mscni_rules(p, rk, d, eps_p, nodes=nodes)
+        sub = np.flatnonzero(np.isin(d.subcell_node, mine)) if nodes is not None else np.arange(len(d.subcell_node))
+        owner = d.subcell_node[sub]
+        return BiotIntegration(nodal, [nodal, values], [mine, owner], rules,
+                               [mine] * (len(rules) - 1) + [owner], mine, sub)
     nodal = dni(p, rk, d, nodes=nodes)
     subcells = np.flatnonzero(np.isin(d.subcell_node, mine)) if nodes is not None else None
-    return BiotIntegration(nodal, [nodal], [mine], mine, subcells)
+    return BiotIntegration(nodal, [nodal], [mine], [nodal], [mine], mine, subcells)
 
 
 def projection_rows(rk: RKApproximation, domains: NodalDomains, integration: BiotIntegration
@@ -276,13 +284,13 @@ def biot_operators(p: Particles, rk: RKApproximation, domains: NodalDomains, mat
     fields.check(n)
     it = biot_integration(p, rk, d, variant, eps_p, nodes)
     quads, nodal, mine = it.quads, it.nodal, it.nodes
-    kuu = stiffness(quads, it.at_points(fields.D, material.elastic.D()))
+    kuu = stiffness(it.gradient_quads, it.at_points(fields.D, material.elastic.D(), gradients=True))
     # Coupling (3.57): nodal points only.
     alpha = material.alpha if fields.alpha is None else np.asarray(fields.alpha, float)[mine]
     kup = (divergence_matrix(nodal).T @ sp.diags(alpha * nodal.weights) @ nodal.values.matrix()).tocsr()
     ks = mass(quads, it.at_points(fields.S, material.S)) if (material.S > 0 or fields.S is not None) \
         else sp.csr_matrix((n, n))
-    kh = laplacian(quads, it.at_points(fields.k, material.k))
+    kh = laplacian(it.gradient_quads, it.at_points(fields.k, material.k, gradients=True))
     rows, weights, row_nodes = projection_rows(rk, d, it) if variant.endswith("+fpp") else ([], [], [])
     h = np.sqrt(d.area)
     if nodes is not None:  # the other nodes' cells may be partial (domains built around ``nodes``)
