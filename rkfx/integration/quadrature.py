@@ -105,6 +105,24 @@ class SmoothedGradients:
 POINTS_PER_BLOCK = 1_000_000
 
 
+def selected_cells(domains: NodalDomains, nodes: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """The cells ``nodes`` (all when ``None``) and their subcells, in index order."""
+    if nodes is None:
+        return np.arange(len(domains.area)), np.arange(len(domains.subcell_area))
+    nodes = np.asarray(nodes, dtype=np.int64)
+    mine = np.zeros(len(domains.area), bool)
+    mine[nodes] = True
+    return nodes, np.flatnonzero(mine[domains.subcell_node])
+
+
+def _value_differences(rk: RKApproximation, d: NodalDomains, node_values: SparseRows, nodes: np.ndarray,
+                       sub: np.ndarray) -> SparseRows:
+    """The rows N(x_L) - N(x_hat_C) of the subcells ``sub`` (eq. 3.58); ``node_values``: N at ``nodes``."""
+    row_of = np.full(len(d.area), -1, np.int64)
+    row_of[nodes] = np.arange(len(nodes))
+    return difference_rows(node_values, row_of[d.subcell_node[sub]], evaluate(rk, d.subcell_centroid[sub]))
+
+
 def smoothed_gradients(p: Particles, rk: RKApproximation, domains: NodalDomains,
                        subcells: bool = True, nodes: np.ndarray | None = None) -> SmoothedGradients:
     """N at the smoothing points, combined into cell smoothed gradients and, with ``subcells``,
@@ -116,14 +134,7 @@ def smoothed_gradients(p: Particles, rk: RKApproximation, domains: NodalDomains,
     ``POINTS_PER_BLOCK``; every row is the same, entry for entry, whatever the blocks.
     """
     d = domains
-    num_cells = len(d.area)
-    if nodes is None:
-        nodes, sub = np.arange(num_cells), np.arange(len(d.subcell_area))
-    else:
-        nodes = np.asarray(nodes, dtype=np.int64)
-        mine = np.zeros(num_cells, bool)
-        mine[nodes] = True
-        sub = np.flatnonzero(mine[d.subcell_node])
+    nodes, sub = selected_cells(d, nodes)
     slot = np.full(len(d.smoothing_points), -1, np.int32)
     if subcells:
         cell, diff = _cells_and_subcells(rk, d, nodes, sub, slot)
@@ -282,13 +293,7 @@ def mscni_rules(p: Particles, rk: RKApproximation, domains: NodalDomains, eps_p:
     if not eps_p >= 0:
         raise InputError(f"eps_p = {eps_p!r} must be >= 0 (1 is the usual MSCNI choice)")
     d = domains
-    if nodes is None:
-        nodes, sub = np.arange(len(d.area)), np.arange(len(d.subcell_area))
-    else:
-        nodes = np.asarray(nodes, dtype=np.int64)
-        mine = np.zeros(len(d.area), bool)
-        mine[nodes] = True
-        sub = np.flatnonzero(mine[d.subcell_node])
+    nodes, sub = selected_cells(d, nodes)
     cell, grads = _cells_and_subcells(rk, d, nodes, sub, np.full(len(d.smoothing_points), -1, np.int32),
                                       difference=False)
     node_values = evaluate(rk, p.x[nodes])
@@ -299,9 +304,7 @@ def mscni_rules(p: Particles, rk: RKApproximation, domains: NodalDomains, eps_p:
         rules.insert(0, Quadrature(nodal.points, (1.0 - eps_p) * nodal.weights, None, cell, "scni"))
     if not with_values:
         return nodal, rules, None
-    row_of = np.full(len(d.area), -1, np.int64)
-    row_of[nodes] = np.arange(len(nodes))
-    values = difference_rows(node_values, row_of[d.subcell_node[sub]], evaluate(rk, centroids))
+    values = _value_differences(rk, d, node_values, nodes, sub)
     return nodal, rules, Quadrature(centroids, weights, values, None, "mscni-values")
 
 
@@ -329,10 +332,7 @@ def mscni_stabilization(p: Particles, rk: RKApproximation, domains: NodalDomains
     diff = s.cell_minus_subcell
     values = None
     if with_values:
-        row_of = np.full(len(d.area), -1, np.int64)
-        row_of[s.nodes] = np.arange(len(s.nodes))
-        values = difference_rows(s.node_values, row_of[d.subcell_node[s.subcells]],
-                                 evaluate(rk, d.subcell_centroid[s.subcells]))
+        values = _value_differences(rk, d, s.node_values, s.nodes, s.subcells)
     return Quadrature(d.subcell_centroid[s.subcells], eps_p * d.subcell_area[s.subcells], values, diff,
                       "mscni-stabilization")
 

@@ -42,7 +42,7 @@ from rkfx.errors import InputError
 from rkfx.geometry.nodal_domains import NodalDomains, nodal_domains
 from rkfx.assembly.operators import laplacian, mass, stiffness
 from rkfx.geometry.particles import Particles
-from rkfx.integration.quadrature import Quadrature, dni, mscni_rules, scni
+from rkfx.integration.quadrature import Quadrature, dni, mscni_rules, scni, selected_cells
 from rkfx.approximation.shape_functions import RKApproximation, evaluate, rk_approximation
 from rkfx.parallel.ownership import numbering
 from rkfx.parallel.partition import rcb
@@ -230,7 +230,7 @@ def biot_integration(p: Particles, rk: RKApproximation, domains: NodalDomains, v
     mine = np.arange(p.num_nodes) if nodes is None else np.asarray(nodes, np.int64)
     if variant.startswith("scni"):
         nodal, rules, values = mscni_rules(p, rk, d, eps_p, nodes=nodes)
-        sub = np.flatnonzero(np.isin(d.subcell_node, mine)) if nodes is not None else np.arange(len(d.subcell_node))
+        _, sub = selected_cells(d, nodes)
         owner = d.subcell_node[sub]
         return BiotIntegration(nodal, [nodal, values], [mine, owner], rules,
                                [mine] * (len(rules) - 1) + [owner], mine, sub)
