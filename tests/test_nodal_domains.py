@@ -101,6 +101,10 @@ def test_smoothed_gradients_in_blocks_of_points_equal_one_block(monkeypatch, nod
     many_sub = quadrature.subcell_gradients(rk, d, nodes=sel)
     assert np.array_equal(one.subcells, many.subcells)
     assert np.array_equal(one_sub[2], many_sub[2])
+    alone = quadrature.subcell_gradients(rk, d, nodes=sel, with_cells=False)  # the subcell rule's build
+    assert alone[0] is None
+    for name in ("indptr", "indices", "data"):
+        assert np.array_equal(getattr(alone[1], name), getattr(many_sub[1], name)), name
     for x, y in ((one.cell, many.cell), (one.cell_minus_subcell, many.cell_minus_subcell),
                  (one_sub[0], many_sub[0]), (one_sub[1], many_sub[1])):
         assert x.num_rows > 0

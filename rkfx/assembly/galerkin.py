@@ -1,7 +1,7 @@
 """Galerkin matrices sum_q w_q B_q^T D_q B_q assembled straight into their CSR rows, compiled:
 the elastic stiffness (``elastic_stiffness``) and the scalar forms sum_q w_q a_I^T M_q a_J of
-one-field operators, the Darcy matrix over gradient rows and the mass over value rows
-(``scalar_form``).
+one-field operators (``scalar_form``): the Darcy matrix over gradient rows. It takes value rows
+too, but the mass stays one scipy product, measured faster (``rkfx.assembly.operators.mass``).
 
 A product of scipy matrices (B^T, then diag(w D), then B) forms intermediates several times
 the size of K: at 9 x 10^4 nodes with the MSCNI rows, 1.4 GB of transients for a K of 167 MB,

@@ -193,10 +193,11 @@ def _cell_blocks(rk: RKApproximation, d: NodalDomains, nodes: np.ndarray, slot: 
 
 
 def _cells_and_subcells(rk: RKApproximation, d: NodalDomains, nodes: np.ndarray, sub: np.ndarray, slot: np.ndarray,
-                        difference: bool = True) -> tuple[SparseRows, SparseRows]:
+                        difference: bool = True, with_cells: bool = True) -> tuple[SparseRows | None, SparseRows]:
     """The cell rows of ``nodes`` and the rows of their subcells ``sub`` (in that order), a
     block of subcells at a time: the MSCNI rows grad~N(x_L) - grad~N(x_hat_C) (eq. 3.56), or
-    without ``difference`` the subcell gradients grad~N(x_hat_C) themselves.
+    without ``difference`` the subcell gradients grad~N(x_hat_C) themselves; without
+    ``with_cells`` (and ``difference``) the subcell rows alone, the cell rows ``None``.
 
     A block evaluates N once, at its subcells' sides and at the cell boundaries of the nodes
     whose cell rows it is the first to need (a cell's boundary segments are sides of its
@@ -208,7 +209,7 @@ def _cells_and_subcells(rk: RKApproximation, d: NodalDomains, nodes: np.ndarray,
     cells, subs = RowStack(len(nodes)), RowStack(len(sub))
     for lo, hi in _block_bounds(np.full(len(sub), 4), POINTS_PER_BLOCK):
         block = sub[lo:hi]
-        new = np.unique(owner[lo:hi])
+        new = np.unique(owner[lo:hi]) if with_cells or difference else owner[:0]
         new = new[where[new] < 0]
         ptr, terms, weight = _cell_terms(d, new)
         points, local = _renumber(np.concatenate([d.cell_point[terms], d.subcell_point[block].ravel()]), slot)
@@ -221,6 +222,8 @@ def _cells_and_subcells(rk: RKApproximation, d: NodalDomains, nodes: np.ndarray,
                                 base_row=where[owner[lo:hi]]) if difference else
                     combine_job(at, sides, local[len(terms):], side_weight))
         del at
+    if not (with_cells or difference):
+        return None, subs.rows()
     rest = nodes[where[nodes] < 0]  # cells without subcells
     if rest.size:
         where[rest] = cells.count + np.arange(len(rest))
@@ -233,8 +236,8 @@ def _cells_and_subcells(rk: RKApproximation, d: NodalDomains, nodes: np.ndarray,
     return cell, subs.rows()
 
 
-def subcell_gradients(rk: RKApproximation, domains: NodalDomains, nodes: np.ndarray | None = None
-                      ) -> tuple[SparseRows, SparseRows, np.ndarray]:
+def subcell_gradients(rk: RKApproximation, domains: NodalDomains, nodes: np.ndarray | None = None,
+                      with_cells: bool = True) -> tuple[SparseRows | None, SparseRows, np.ndarray]:
     """The smoothed gradients of eq. (3.55) over each cell, grad~N_I(x_L), and over each of
     its subcells, grad~N_I(x_hat_C) (the subcell rows of eq. 3.56), a block of subcells at a
     time (``POINTS_PER_BLOCK``).
@@ -246,20 +249,23 @@ def subcell_gradients(rk: RKApproximation, domains: NodalDomains, nodes: np.ndar
 
     Returns:
         (cell rows, subcell rows, order): subcell row k belongs to subcell ``order[k]`` of
-        ``domains``; the rows are grouped by particle (stable sort of ``subcell_node``).
+        ``domains``; the rows are grouped by particle (stable sort of ``subcell_node``). The
+        cell rows are ``None`` without ``with_cells``.
     """
     d = domains
     order = np.argsort(d.subcell_node, kind="stable")
     slot = np.full(len(d.smoothing_points), -1, np.int32)
     if nodes is None:
-        cell, sub = _cells_and_subcells(rk, d, np.arange(len(d.area)), order, slot, difference=False)
+        cell, sub = _cells_and_subcells(rk, d, np.arange(len(d.area)), order, slot, difference=False,
+                                        with_cells=with_cells)
         return cell, sub, order
     nodes = np.asarray(nodes, dtype=np.int64)
     mine = np.zeros(len(d.area), bool)
     mine[nodes] = True
     filled = np.flatnonzero(mine[d.subcell_node[order]])  # places of the selected subcells' rows
-    cell, sub = _cells_and_subcells(rk, d, nodes, order[filled], slot, difference=False)
-    return spread_rows(cell, nodes, len(d.area)), spread_rows(sub, filled, len(order)), order
+    cell, sub = _cells_and_subcells(rk, d, nodes, order[filled], slot, difference=False, with_cells=with_cells)
+    return (None if cell is None else spread_rows(cell, nodes, len(d.area))), spread_rows(sub, filled, len(order)), \
+        order
 
 
 def subcell_rule(rk: RKApproximation, domains: NodalDomains, nodes: np.ndarray | None = None) -> Quadrature:
@@ -269,7 +275,7 @@ def subcell_rule(rk: RKApproximation, domains: NodalDomains, nodes: np.ndarray |
     (sum_C A_C B_C = A_L B_L, sum_C A_C = A_L), so eq. (3.56) gives
     A_L B_L^T D B_L + sum_C A_C (B_L - B_C)^T D (B_L - B_C) = sum_C A_C B_C^T D B_C,
     from fewer and shorter rows."""
-    _, sub, order = subcell_gradients(rk, domains, nodes=nodes)
+    _, sub, order = subcell_gradients(rk, domains, nodes=nodes, with_cells=False)
     return Quadrature(domains.subcell_centroid[order], domains.subcell_area[order], None, sub, "subcells")
 
 

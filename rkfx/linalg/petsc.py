@@ -190,7 +190,7 @@ class LinearSolver:
 
     def __init__(self, a: sp.spmatrix, comm=MPI.COMM_WORLD, solver: str = "mumps",
                  mumps_icntl: Mapping[int, int] | None = None, owned_rows: bool = False,
-                 coordinates: np.ndarray | None = None):
+                 coordinates: np.ndarray | None = None, symmetric: bool = False):
         self.solver, self.owned_rows = solver, owned_rows
         a = _sorted_csr(a)
         if owned_rows:  # a is this rank's block of rows (owned_rows_mat); b is too
@@ -199,8 +199,11 @@ class LinearSolver:
         else:
             self.pattern = (a.shape, a.indptr.copy(), a.indices.copy())
             self.mat = to_petsc_mat(a, comm)
-        # A symmetric matrix (whole on every rank) is factorized as L D L^T: half the work of LU.
-        self.symmetric = solver == "mumps" and not owned_rows and is_symmetric(a)
+        # symmetric=True: L D L^T for a matrix that is (``is_symmetric``), whole on every rank.
+        # Not the default: on the saddle points of the transformation method (zero diagonal
+        # block) MUMPS's pivoting L D L^T took 36.9 s where LU took 4.2 s (Sneddon, 99,844
+        # unknowns); on Mandel's u-p steps it saved memory (docs/verification.md).
+        self.symmetric = symmetric and solver == "mumps" and not owned_rows and is_symmetric(a)
         self.ksp = make_ksp(self.mat, solver, mumps_icntl=mumps_icntl, coordinates=coordinates,
                             symmetric=self.symmetric)
         self.rhs = self.mat.createVecLeft()

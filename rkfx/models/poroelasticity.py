@@ -235,7 +235,7 @@ def biot_integration(p: Particles, rk: RKApproximation, domains: NodalDomains, v
         return BiotIntegration(nodal, [nodal, values], [mine, owner], rules,
                                [mine] * (len(rules) - 1) + [owner], mine, sub)
     nodal = dni(p, rk, d, nodes=nodes)
-    subcells = np.flatnonzero(np.isin(d.subcell_node, mine)) if nodes is not None else None
+    subcells = selected_cells(d, nodes)[1] if nodes is not None else None
     return BiotIntegration(nodal, [nodal], [mine], [nodal], [mine], mine, subcells)
 
 
