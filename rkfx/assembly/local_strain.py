@@ -31,8 +31,8 @@ import numba
 import numpy as np
 
 from rkfx.approximation.sparse_rows import SparseRows, gathered_rows
-from rkfx.assembly.smeared_strain import (SmearedStrain, StrainRecipe, cell_average, row_strains, subcell_load,
-                                          transposed_force)
+from rkfx.assembly.smeared_strain import (SmearedStrain, StrainRecipe, cell_average, damaged_subcell_stress,
+                                          row_strains, subcell_load, transposed_force)
 from rkfx.errors import InputError
 from rkfx.parallel.halo import Halo, halo
 
@@ -141,6 +141,13 @@ class LocalSmearedStrain:
         transposed_force(self.rows_t, load, self.row_weight, out=f[:2 * len(self.owned_nodes)])
         self.node_halo.exchange(f.reshape(-1, 2))
         return f
+
+    def damaged_force(self, stress: np.ndarray, differences: np.ndarray, c: np.ndarray,
+                      damage: np.ndarray) -> np.ndarray:
+        """``force`` with the damaged MSCNI subcell stresses of ``differences`` (as
+        ``SmearedStrain.damaged_force``; damage per owned point). Collective."""
+        damaged_subcell_stress(differences, c, self.stabilization.owner, damage, differences)
+        return self.force(stress, differences)
 
 
 def _ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:

@@ -34,6 +34,9 @@ from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.errors import InputError
 from rkfx.geometry.nodal_domains import NodalDomains, nodal_domains
 from rkfx.assembly.operators import strain_matrix
+from rkfx.assembly.lattice_stencil import (LatticeStencil, lattice_of, lattice_stencil, snap_to_template,
+                                           sort_rows, template_particle, template_rows)
+from rkfx.assembly.row_products import damaged_stress, node_force, particle_average, particle_load, row_strain
 from rkfx.geometry.particles import Particles
 from rkfx.integration.quadrature import smoothed_gradients, subcell_gradients
 from rkfx.approximation.shape_functions import RKApproximation
@@ -45,37 +48,14 @@ from rkfx.approximation.sparse_rows import SparseRows, spread_rows
 def _strain(indptr, indices, grad, d, out):
     """Smeared strains of every node L: sum_I B~_I(x_L) d_I, rows in parallel (eq. 4.31)."""
     for row in numba.prange(len(indptr) - 1):
-        exx = 0.0
-        eyy = 0.0
-        gxy = 0.0
-        for q in range(indptr[row], indptr[row + 1]):
-            i = indices[q]
-            gx = grad[q, 0]
-            gy = grad[q, 1]
-            ux = d[2 * i]
-            uy = d[2 * i + 1]
-            exx += gx * ux
-            eyy += gy * uy
-            gxy += gy * ux + gx * uy
-        out[row, 0] = exx
-        out[row, 1] = eyy
-        out[row, 2] = gxy
+        row_strain(indptr, indices, grad, d, row, out)
 
 
 @numba.njit(parallel=True, cache=True)
 def _force(indptr, indices, grad, stress, volume, out):
     """f_I = sum_L B~_I(x_L)^T Sigma_L V_L over the transposed rows (eq. 4.34), nodes in parallel."""
     for node in numba.prange(len(indptr) - 1):
-        fx = 0.0
-        fy = 0.0
-        for q in range(indptr[node], indptr[node + 1]):
-            ell = indices[q]
-            gx = grad[q, 0] * volume[ell]
-            gy = grad[q, 1] * volume[ell]
-            fx += gx * stress[ell, 0] + gy * stress[ell, 2]
-            fy += gy * stress[ell, 1] + gx * stress[ell, 2]
-        out[2 * node] = fx
-        out[2 * node + 1] = fy
+        node_force(indptr, indices, grad, stress, volume, node, out)
 
 
 @numba.njit(parallel=True, cache=True)
@@ -85,21 +65,7 @@ def cell_average(ptr, fraction, sub):
     n = len(ptr) - 1
     cell = np.empty((n, 3))
     for ell in numba.prange(n):
-        a0 = 0.0
-        a1 = 0.0
-        a2 = 0.0
-        for c in range(ptr[ell], ptr[ell + 1]):
-            f = fraction[c]
-            a0 += f * sub[c, 0]
-            a1 += f * sub[c, 1]
-            a2 += f * sub[c, 2]
-        cell[ell, 0] = a0
-        cell[ell, 1] = a1
-        cell[ell, 2] = a2
-        for c in range(ptr[ell], ptr[ell + 1]):
-            sub[c, 0] = a0 - sub[c, 0]
-            sub[c, 1] = a1 - sub[c, 1]
-            sub[c, 2] = a2 - sub[c, 2]
+        particle_average(ptr, fraction, sub, ell, cell)
     return cell
 
 
@@ -110,23 +76,20 @@ def subcell_load(ptr, fraction, weight, volume, stress, sub_stress, out):
     (``sub_stress`` empty: no MSCNI terms)."""
     with_sub = sub_stress.shape[0] > 0
     for ell in numba.prange(len(ptr) - 1):
-        t0 = volume[ell] * stress[ell, 0]
-        t1 = volume[ell] * stress[ell, 1]
-        t2 = volume[ell] * stress[ell, 2]
-        if with_sub:
-            for c in range(ptr[ell], ptr[ell + 1]):
-                t0 += weight[c] * sub_stress[c, 0]
-                t1 += weight[c] * sub_stress[c, 1]
-                t2 += weight[c] * sub_stress[c, 2]
-        for c in range(ptr[ell], ptr[ell + 1]):
-            f = fraction[c]
-            out[c, 0] = f * t0
-            out[c, 1] = f * t1
-            out[c, 2] = f * t2
-            if with_sub:
-                out[c, 0] -= weight[c] * sub_stress[c, 0]
-                out[c, 1] -= weight[c] * sub_stress[c, 1]
-                out[c, 2] -= weight[c] * sub_stress[c, 2]
+        particle_load(ptr, fraction, weight, volume, stress, sub_stress, with_sub, ell, out)
+
+
+@numba.njit(parallel=True, cache=True)
+def damaged_subcell_stress(strain, c, owner, damage, stress):
+    """(1 - D_L) C (B~_L - B~_C) d per subcell C of particle L (the damaged MSCNI terms), from
+    the differences ``strain`` into ``stress`` (which may be ``strain``)."""
+    for k in numba.prange(strain.shape[0]):
+        s = 1.0 - damage[owner[k]]
+        e0 = strain[k, 0]
+        e1 = strain[k, 1]
+        e2 = strain[k, 2]
+        for j in range(3):
+            stress[k, j] = damaged_stress(c, s, e0, e1, e2, j)
 
 
 @numba.njit(parallel=True, cache=True)
@@ -169,6 +132,8 @@ class Stabilization:
         owner: Particle L of each subcell, shape ``(num_subcells,)``.
         fraction: A_C / A_L, shape ``(num_subcells,)``.
         weight: eps_p A_C, shape ``(num_subcells,)`` [m^2].
+        stencil: The products as lattice stencils where the rows are a uniform grid's
+            template (``rkfx.assembly.lattice_stencil``), or ``None``.
     """
 
     rows: SparseRows
@@ -176,6 +141,7 @@ class Stabilization:
     owner: np.ndarray
     fraction: np.ndarray
     weight: np.ndarray
+    stencil: LatticeStencil | None = None
 
     @cached_property
     def rows_t(self) -> SparseRows:
@@ -233,6 +199,9 @@ class SmearedStrain:
         s = self.stabilization
         if s is None:
             raise InputError("this operator has no MSCNI terms; build it with smeared_strain(..., eps_p=1)")
+        d = np.ascontiguousarray(d, dtype=np.float64)
+        if s.stencil is not None:
+            return s.stencil.strains(s.rows, s.ptr, s.fraction, d)
         sub = row_strains(s.rows, d)
         return cell_average(s.ptr, s.fraction, sub), sub
 
@@ -248,9 +217,25 @@ class SmearedStrain:
             return transposed_force(self.rows_t, stress, self.volume)
         sub = np.empty((0, 3)) if subcell_stress is None else \
             np.ascontiguousarray(subcell_stress, dtype=np.float64)
+        if s.stencil is not None:
+            return s.stencil.force(s.rows_t, s.ptr, s.fraction, s.weight, self.volume, stress, sub, s._unit)
         load = np.empty((len(s.owner), 3))
         subcell_load(s.ptr, s.fraction, s.weight, self.volume, stress, sub, load)
         return transposed_force(s.rows_t, load, s._unit)
+
+    def damaged_force(self, stress: np.ndarray, differences: np.ndarray, c: np.ndarray,
+                      damage: np.ndarray) -> np.ndarray:
+        """``force(stress, s)`` with the subcell stresses s_C = (1 - D_L) C (B~_L - B~_C) d of
+        the MSCNI differences ``differences`` (``strains``; overwritten), elasticity ``c``
+        (3, 3) and damage D per particle: the damage particle method's force (eq. 4.34 with
+        the terms of 3.56)."""
+        s = self.stabilization
+        if s.stencil is not None:
+            return s.stencil.damaged_force(s.rows_t, s.ptr, s.fraction, s.weight, self.volume,
+                                           np.ascontiguousarray(stress, dtype=np.float64), differences, c, damage,
+                                           s._unit)
+        damaged_subcell_stress(differences, c, s.owner, damage, differences)
+        return self.force(stress, differences)
 
     @cached_property
     def B(self) -> sp.csr_matrix:
@@ -291,9 +276,13 @@ def check_eps_p(eps_p: float) -> None:
 
 
 def smeared_strain(p: Particles, rk: RKApproximation, domains: NodalDomains | None = None,
-                   eps_p: float = 0.0, points: np.ndarray | None = None) -> SmearedStrain:
+                   eps_p: float = 0.0, points: np.ndarray | None = None, lattice: bool = True) -> SmearedStrain:
     """B~ from the SCNI smoothed gradients on the nodal cells (eq. 3.55 = eq. 4.33), with the
     MSCNI subcell terms of eq. (3.56) when ``eps_p`` > 0 (1 is the usual choice).
+
+    On a uniform grid (and ``lattice``) the subcell rows of the particles away from the
+    boundary and the cracks are snapped to one template and, for the whole operator, evaluated
+    by stencils (``rkfx.assembly.lattice_stencil``: the same numbers bit for bit, fewer bytes).
 
     ``points`` (ascending particle indices) builds only the rows of those particles (the others
     stay empty, in their places): enough for a rank's ``local_smeared_strain`` when they are
@@ -322,8 +311,9 @@ def smeared_strain(p: Particles, rk: RKApproximation, domains: NodalDomains | No
     ptr = np.zeros(p.num_nodes + 1, np.int64)
     np.cumsum(np.bincount(owner, minlength=p.num_nodes), out=ptr[1:])
     area = domains.subcell_area[order]
+    stencil = _snapped_stencil(p, rk, domains, sub, ptr, points) if lattice else None
     stab = Stabilization(sub, ptr, owner, np.ascontiguousarray(area / volume[owner]),
-                         np.ascontiguousarray(eps_p * area, dtype=np.float64))
+                         np.ascontiguousarray(eps_p * area, dtype=np.float64), stencil)
     op = SmearedStrain(cell, volume, stab)
     probe = np.random.default_rng(0).standard_normal(2 * p.num_nodes)
     direct = row_strains(cell, probe)
@@ -334,6 +324,31 @@ def smeared_strain(p: Particles, rk: RKApproximation, domains: NodalDomains | No
     if points is None:
         stab.rows_t  # noqa: B018 - the transpose f_int reads, built at set-up
     return op
+
+
+def _snapped_stencil(p: Particles, rk: RKApproximation, domains: NodalDomains, sub: SparseRows, ptr: np.ndarray,
+                     points: np.ndarray | None) -> LatticeStencil | None:
+    """Snap the subcell rows ``sub`` of a uniform grid to the template particle's
+    (``rkfx.assembly.lattice_stencil``) and, if they are the whole operator's, return their
+    stencils; ``None`` (rows untouched) off a grid, without a template particle, or when these
+    domains hold no cell of it."""
+    lat = lattice_of(p.x)
+    c = None if lat is None else template_particle(p.x, rk)
+    if c is None:
+        return None
+    if points is None or np.isin(c, points):
+        source = sub
+    elif np.diff(domains.cell_ptr)[c] > 0:
+        source = subcell_gradients(rk, domains, nodes=np.array([c]), with_cells=False)[1]
+        sort_rows(source)
+    else:
+        return None
+    sort_rows(sub)
+    template = template_rows(source, ptr, c)
+    matched = snap_to_template(sub, ptr, template, lat)
+    if points is not None:
+        return None
+    return lattice_stencil(sub, ptr, matched, template, lat)
 
 
 @dataclass(frozen=True)

@@ -26,6 +26,7 @@ import numpy as np
 from rkfx.fracture import damage as dm
 from rkfx.fracture.tracking import Tracking
 from rkfx.approximation.diffraction import Cracks, cracks
+from rkfx.assembly.lattice_stencil import template_particle
 from rkfx.assembly.smeared_strain import SmearedStrain, StrainRecipe, lumped_mass, near_part, stable_time_step
 from rkfx.models.damage_dynamics import DamageRun, Frames, run_damage
 from rkfx.geometry.grid_cells import grid_domains
@@ -115,6 +116,9 @@ def plate(xs: np.ndarray, ys: np.ndarray, slits: Sequence, tips: Sequence[tuple[
         # half its diagonal of its particle
         reach = 0.5 * np.hypot(np.diff(xs).max(), np.diff(ys).max())
         nodes = near_part(p.x, rcb(p.x, comm.size), comm.rank, 1.001 * (rk.support.max() + reach))
+        template = template_particle(p.x, rk)  # every rank snaps its rows to its rows (lattice_stencil)
+        if template is not None:
+            nodes = np.union1d(nodes, [template])
     domains = grid_domains(xs, ys, slits, nodes=nodes)
     recipe = StrainRecipe(p, rk, domains, eps_p)
     op = recipe if parallel else recipe.build()

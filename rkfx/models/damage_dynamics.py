@@ -79,18 +79,6 @@ class StrainOperator(Protocol):
     def force(self, stress: np.ndarray) -> np.ndarray: ...  # sum_L B_L^T Sigma_L V_L, (2 n,)
 
 
-@numba.njit(parallel=True, cache=True)
-def _subcell_stress(strain, c, owner, damage, stress):
-    """(1 - D_L) C (B~_L - B~_C) d per subcell C of particle L (the damaged MSCNI terms)."""
-    for k in numba.prange(strain.shape[0]):
-        s = 1.0 - damage[owner[k]]
-        e0 = strain[k, 0]
-        e1 = strain[k, 1]
-        e2 = strain[k, 2]
-        for j in range(3):
-            stress[k, j] = s * (c[j, 0] * e0 + c[j, 1] * e1 + c[j, 2] * e2)
-
-
 @dataclass
 class DamageField:
     """History of the damage particles, updated in place by ``DamageForce``.
@@ -195,8 +183,7 @@ class DamageForce:
             damage = 1.0 - kept
         if stab is None:
             return op.force(self.stress)
-        _subcell_stress(diff, self.c, stab.owner, damage, diff)
-        return op.force(self.stress, diff)
+        return op.damaged_force(self.stress, diff, self.c, damage)
 
     def _initiate_all(self, new: np.ndarray) -> None:
         """The initiations of this evaluation (``rkfx.models.damage_ranks`` gathers them over ranks)."""

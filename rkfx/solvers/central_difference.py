@@ -424,13 +424,31 @@ class _Projection:
             raise InputError("the constraint rows are linearly dependent (G M^-1 G^T is singular); "
                              "prescribe each (node, component) once")
         self.sizes = [c.count for c in self.parts]
+        # The corrections touch only the unknowns in the supports of the constraint rows:
+        # M^-1 G^T is kept as its nonzero rows, and each correction in a whole-length buffer
+        # that is zero elsewhere for good (a step makes two and their sum).
+        self.rows = np.flatnonzero(np.diff(self.minv_gt.indptr))
+        self.minv_gt_rows = self.minv_gt[self.rows]
+        self._buffers = [np.zeros(len(mass)) for _ in range(3)]
+        self._next = 0
 
     def project(self, w: np.ndarray, target: np.ndarray) -> np.ndarray:
-        """w + M^-1 G^T lambda with G (w + ...) = target; returns the correction."""
+        """w + M^-1 G^T lambda with G (w + ...) = target; returns the correction (a buffer that
+        the third call after this one overwrites)."""
         lam = self.lu.solve(target - self.G @ w)
-        dw = self.minv_gt @ lam
-        w += dw
-        return dw
+        dw = self.minv_gt_rows @ lam
+        w[self.rows] += dw
+        return self._correction(dw)
+
+    def combined(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """a + b of two corrections of ``project``."""
+        return self._correction(a[self.rows] + b[self.rows])
+
+    def _correction(self, values: np.ndarray) -> np.ndarray:
+        out = self._buffers[self._next]
+        self._next = (self._next + 1) % len(self._buffers)
+        out[self.rows] = values
+        return out
 
     def half_step_target(self, d: np.ndarray, t_next: float, dt: float) -> np.ndarray:
         """Velocity target for v_{n+1/2}: G v = (g(t_{n+1}) - G d_n) / dt, or v_bar(t_{n+1/2})."""
@@ -553,7 +571,7 @@ class CentralDifference:
         if proj.G is not None:
             # Constraint force over the step: the impulses of the half-step projection and of
             # the full-step one at its end (each carries half of it for a steady reaction).
-            dv = dv + proj.project(s.v, proj.velocity_target(t_next, dt))
+            dv = proj.combined(dv, proj.project(s.v, proj.velocity_target(t_next, dt)))
         inc = work.total(_energy_increments(s.v, mass, work.dd, s.f_int, f_int, s.f_ext, f_ext, dv, work.owned))
         e = s.energy
         s.energy = np.array([inc[0], e[1] + inc[1], e[2] + inc[2], e[3] + inc[3] / dt])
