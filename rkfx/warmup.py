@@ -19,7 +19,8 @@ def warm_up() -> None:
     from rkfx.geometry.nodal_domains import nodal_domains
     from rkfx.assembly.operators import stiffness
     from rkfx.linalg.symmetry import is_symmetric
-    from rkfx.geometry.particles import structured
+    from rkfx.geometry.grid_cells import grid_domains
+    from rkfx.geometry.particles import graded, structured
     from rkfx.integration.quadrature import integration_rules, mscni_stabilization, smoothed_gradients
     from rkfx.approximation.shape_functions import evaluate, rk_approximation
 
@@ -38,3 +39,9 @@ def warm_up() -> None:
     model = damage_model(DamageMaterial(1.0, 0.3, 1e-3, 1e-3), d.area, geometry=cell_geometry(p))
     run_damage("warm-up", smeared_strain(p, rk, d), lumped_mass(d.area, 1.0), 1e-3, model, None, (), 2e-3)
     update(model, initial_state(model), np.tile([2e-3, 0.0, 0.0], (p.num_nodes, 1)))  # the quasi-static law
+    xs = np.linspace(0.0, 1.0, 16)  # a grid with an interior: the lattice stencils of an MSCNI step
+    g = graded(xs, xs)
+    op = smeared_strain(g, rk_approximation(g.x, g.spacing, 2.0), grid_domains(xs, xs), eps_p=1.0)
+    e, diff = op.strains(np.zeros(2 * g.num_nodes))
+    op.force(e, diff)
+    op.damaged_force(e, diff, ElasticMaterial(1.0, 0.3).D(), np.zeros(g.num_nodes))
