@@ -85,6 +85,13 @@ class NodalDomains:
     boundary: BoundarySegments
     subcell_vertices: np.ndarray | None = None
 
+    def __post_init__(self):
+        # Node and point indices are kept as int32 (a 10^6-node grid's cells: 0.18 GB less).
+        for name in ("subcell_node", "subcell_point", "cell_point"):
+            a = np.asarray(getattr(self, name))
+            if a.dtype != np.int32 and (a.size == 0 or a.max() < np.iinfo(np.int32).max):
+                object.__setattr__(self, name, a.astype(np.int32))
+
 
 def _normal_length(p, q):
     """Outward normal x length of the counter-clockwise side p -> q (shape (..., 2))."""
