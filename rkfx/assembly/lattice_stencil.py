@@ -270,12 +270,7 @@ class LatticeStencil:
                        self.strain_length, slot_major)
         load = np.empty((len(fraction), 3))
         _particle_loads(ptr, fraction, weight, volume, stress, sub_stress, with_sub, self.load_particles, load)
-        out = np.empty(2 * n)
-        _stencil_force(slot_major, self.force_start, self.force_length, self.force_shift, self.force_slot,
-                       self.force_grad, out)
-        _nodes_force(rows_t.indptr, rows_t.indices, rows_t.data, load, unit, self.sparse_nodes, out)
-        return out
-
+        return self._transposed(slot_major, load, rows_t, unit)
 
     def damaged_force(self, rows_t: SparseRows, ptr: np.ndarray, fraction: np.ndarray, weight: np.ndarray,
                       volume: np.ndarray, stress: np.ndarray, differences: np.ndarray, c: np.ndarray,
@@ -290,7 +285,13 @@ class LatticeStencil:
         load = np.empty((len(fraction), 3))
         _particle_damaged_loads(ptr, fraction, weight, volume, stress, differences, c, damage, self.load_particles,
                                 load)
-        out = np.empty(2 * n)
+        return self._transposed(slot_major, load, rows_t, unit)
+
+    def _transposed(self, slot_major: np.ndarray, load: np.ndarray, rows_t: SparseRows,
+                    unit: np.ndarray) -> np.ndarray:
+        """The interleaved force of the loads: slot major by stencil, in subcell order over the
+        sparse nodes' transposed rows."""
+        out = np.empty(2 * slot_major.shape[2])
         _stencil_force(slot_major, self.force_start, self.force_length, self.force_shift, self.force_slot,
                        self.force_grad, out)
         _nodes_force(rows_t.indptr, rows_t.indices, rows_t.data, load, unit, self.sparse_nodes, out)
