@@ -46,8 +46,9 @@ def test_cells_are_the_analytic_rectangles():
     assert np.allclose(d.subcell_centroid, v.mean(axis=1), rtol=1e-14)
     # Every side's smoothing point is its midpoint; cells and subcells are closed polygons.
     assert np.allclose(d.smoothing_points[d.subcell_point], 0.5 * (v + np.roll(v, -1, axis=1)), rtol=0, atol=1e-15)
-    assert np.abs(np.add.reduceat(d.cell_normal_length, d.cell_ptr[:-1])).max() < 1e-15
-    assert np.abs(d.subcell_normal_length.sum(axis=1)).max() < 1e-15
+    ptr, _, normal_length = d.cell_segments(np.arange(p.num_nodes))
+    assert np.abs(np.add.reduceat(normal_length, ptr[:-1])).max() < 1e-15
+    assert np.abs(d.side_normal_length().sum(axis=1)).max() < 1e-15
 
 
 def test_boundary_segments_match_graded_tags():
@@ -179,16 +180,17 @@ def test_cells_of_some_nodes_are_the_whole_builds(slits):
     some = grid_domains(XC, YC, slits, nodes=nodes)
     assert np.array_equal(some.area, whole.area) and np.array_equal(some.second_moment, whole.second_moment)
     kept = np.isin(whole.subcell_node, nodes)
-    for name in ("subcell_node", "subcell_area", "subcell_centroid", "subcell_normal_length", "subcell_vertices"):
+    for name in ("subcell_node", "subcell_area", "subcell_centroid", "subcell_outer", "subcell_vertices"):
         assert np.array_equal(getattr(some, name), getattr(whole, name)[kept]), name
+    assert np.array_equal(some.side_normal_length(), whole.side_normal_length(np.flatnonzero(kept)))
     assert np.array_equal(some.smoothing_points[some.subcell_point], whole.smoothing_points[whole.subcell_point[kept]])
     assert len(some.smoothing_points) < len(whole.smoothing_points)
     others = np.setdiff1d(np.arange(n), nodes)
-    assert np.all(np.diff(some.cell_ptr)[others] == 0)
+    assert np.all(some.segment_counts()[others] == 0)
     for node in nodes:
-        a, b = slice(*some.cell_ptr[node:node + 2]), slice(*whole.cell_ptr[node:node + 2])
-        assert np.array_equal(some.smoothing_points[some.cell_point[a]], whole.smoothing_points[whole.cell_point[b]])
-        assert np.array_equal(some.cell_normal_length[a], whole.cell_normal_length[b])
+        a, b = some.cell_segments([node]), whole.cell_segments([node])
+        assert np.array_equal(some.smoothing_points[a[1]], whole.smoothing_points[b[1]])
+        assert np.array_equal(a[2], b[2])
     assert np.array_equal(some.smoothing_points[some.boundary.point], whole.smoothing_points[whole.boundary.point])
 
 

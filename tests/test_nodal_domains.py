@@ -22,8 +22,10 @@ def test_cells_are_closed_and_boundary_is_the_perimeter():
     p = l_shape(0.1)
     d = nodal_domains(p)
     # sum of n*l over a closed polygon vanishes: for every cell and every subcell.
-    assert np.abs(np.add.reduceat(d.cell_normal_length, d.cell_ptr[:-1])).max() < 1e-15
-    assert np.abs(d.subcell_normal_length.sum(axis=1)).max() < 1e-15
+    ptr, _, normal_length = d.cell_segments(np.arange(p.num_nodes))
+    assert np.array_equal(np.diff(ptr), d.segment_counts()) and np.all(np.diff(ptr) >= 2)
+    assert np.abs(np.add.reduceat(normal_length, ptr[:-1])).max() < 1e-15
+    assert np.abs(d.side_normal_length().sum(axis=1)).max() < 1e-15
     assert abs(d.boundary.length.sum() - 8.0) < 1e-13
     assert set(np.unique(d.boundary.tag)) == {p.tag(n) for n in ("bottom", "right", "inner", "top", "left")}
     # Every boundary node is a vertex of its own cell: it owns the half-segments touching it.
@@ -32,6 +34,28 @@ def test_cells_are_closed_and_boundary_is_the_perimeter():
     # Outward normals: on the L's inner corner sides they point into the cut-out quadrant.
     inner = d.boundary.tag == p.tag("inner")
     assert np.all((d.boundary.normal[inner] @ [1.0, 1.0]) > 0)
+
+
+def test_sides_computed_on_request_are_the_subcell_quadrilaterals():
+    """The side normals (not stored: ``side_normal_length``) are those of the quadrilaterals
+    (v, m_k, g, m_k-1) built independently (``cell_geometry``), for any selection of subcells;
+    each cell's segments are its subcells' outer sides, whose midpoints are the smoothing points."""
+    from rkfx.fracture.damage import cell_geometry  # noqa: PLC0415
+
+    p = l_shape(0.1)
+    d = nodal_domains(p)
+    quads = cell_geometry(p).vertices
+    edge = np.roll(quads, -1, axis=1) - quads
+    assert np.allclose(d.side_normal_length(), np.stack([edge[..., 1], -edge[..., 0]], -1), rtol=0, atol=1e-15)
+    some = np.array([7, 3, 3, len(d.subcell_area) - 1])
+    assert np.array_equal(d.side_normal_length(some), d.side_normal_length()[some])
+    assert np.allclose(d.smoothing_points[d.subcell_point], 0.5 * (quads + np.roll(quads, -1, axis=1)), atol=1e-15)
+    node = int(d.boundary.node[0])  # its cell is bounded by two of its subcells' half-edges too
+    ptr, point, _ = d.cell_segments([node])
+    mine = np.flatnonzero(d.subcell_node == node)
+    assert np.array_equal(point, d.subcell_point[mine][d.subcell_outer[mine]]) and ptr[-1] == len(point)
+    assert np.isin(d.boundary.point[d.boundary.node == node], point).all()
+    assert ptr[-1] == 2 * len(mine) + 2
 
 
 def test_uniform_grid_interior_cells_have_area_h_squared():
@@ -110,6 +134,37 @@ def test_smoothed_gradients_in_blocks_of_points_equal_one_block(monkeypatch, nod
         assert x.num_rows > 0
         for name in ("indptr", "indices", "data"):
             assert np.array_equal(getattr(x, name), getattr(y, name)), name
+
+
+def test_cell_rows_come_in_node_order_without_a_reordering_copy(monkeypatch):
+    """Blocks form the cell rows in the order of the nodes (a cell before or at the first block
+    that needs it): no reordering copy on grids and gmsh meshes; with the triangles shuffled
+    (subcells far from the nodes' order) each block forms the cells it first needs, and the
+    rows are reordered: the same rows either way."""
+    from dataclasses import replace  # noqa: PLC0415
+
+    from rkfx.approximation.shape_functions import rk_approximation  # noqa: PLC0415
+    import rkfx.integration.quadrature as quadrature  # noqa: PLC0415
+
+    p = structured(1.0, 0.6, 23, 14)
+    rk = rk_approximation(p.x, p.spacing)
+    d = nodal_domains(p)
+    one = quadrature.smoothed_gradients(p, rk, d)
+    monkeypatch.setattr(quadrature, "POINTS_PER_BLOCK", 97)
+    copies = []
+    gather = quadrature.gathered_rows
+    monkeypatch.setattr(quadrature, "gathered_rows", lambda *a: copies.append(len(a[1])) or gather(*a))
+    many = quadrature.smoothed_gradients(p, rk, d)
+    assert copies == []
+    for name in ("indptr", "indices", "data"):
+        assert np.array_equal(getattr(one.cell, name), getattr(many.cell, name)), name
+    perm = np.random.default_rng(1).permutation(len(p.triangles))
+    q = replace(p, triangles=p.triangles[perm], triangle_edges=p.triangle_edges[perm])
+    shuffled = quadrature.smoothed_gradients(q, rk, nodal_domains(q))
+    assert copies == [p.num_nodes]
+    for k in range(2):
+        a, b = one.cell.matrix(k), shuffled.cell.matrix(k)
+        assert abs(a - b).max() <= 1e-12 * abs(a).max()
 
 
 def test_stacked_rows_grow_past_a_short_first_guess():

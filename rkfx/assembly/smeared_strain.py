@@ -292,7 +292,7 @@ def smeared_strain(p: Particles, rk: RKApproximation, domains: NodalDomains | No
     domains = domains or nodal_domains(p)
     volume = np.ascontiguousarray(domains.area, dtype=np.float64)
     if points is not None:
-        bare = np.asarray(points)[np.diff(domains.cell_ptr)[points] == 0]
+        bare = np.asarray(points)[domains.segment_counts()[points] == 0]
         if bare.size:
             raise InputError(f"{bare.size} of the particles whose rows are built (first: {bare[0]}) have no cell "
                              "in these nodal domains; build the domains with nodes= covering them")
@@ -338,7 +338,7 @@ def _snapped_stencil(p: Particles, rk: RKApproximation, domains: NodalDomains, s
         return None
     if points is None or np.isin(c, points):
         source = sub
-    elif np.diff(domains.cell_ptr)[c] > 0:
+    elif domains.segment_counts()[c] > 0:
         source = subcell_gradients(rk, domains, nodes=np.array([c]), with_cells=False)[1]
         sort_rows(source)
     else:
@@ -398,12 +398,11 @@ def near_part(x: np.ndarray, part: np.ndarray, rank: int, margin: float) -> np.n
 
 
 def reach(x: np.ndarray, domains: NodalDomains) -> float:
-    """The largest distance from a particle (coordinates ``x``) to one of its smoothing points [m]."""
+    """The largest distance from a particle (coordinates ``x``) to one of its smoothing points
+    (those of its subcells' sides, which include its cell's) [m]."""
     d = domains
-    cell_node = np.repeat(np.arange(len(d.area)), np.diff(d.cell_ptr))
-    far = np.linalg.norm(d.smoothing_points[d.cell_point] - x[cell_node], axis=1).max(initial=0.0)
     sub = np.linalg.norm(d.smoothing_points[d.subcell_point] - x[d.subcell_node][:, None], axis=2)
-    return float(max(far, sub.max(initial=0.0)))
+    return float(sub.max(initial=0.0))
 
 
 def elastic_force(op: SmearedStrain, d_matrix: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:

@@ -127,11 +127,8 @@ def grid_domains(xs: np.ndarray, ys: np.ndarray, slits: Sequence | None = (),
     vx = (xn, np.where(ccw, xf, xn), xf, np.where(ccw, xn, xf))
     vy = (yn, np.where(ccw, yn, yf), yf, np.where(ccw, yf, yn))
     verts = np.empty((len(node), 4, 2))
-    normal_length = np.empty((len(node), 4, 2))
     for k in range(4):
         verts[:, k, 0], verts[:, k, 1] = vx[k], vy[k]
-        normal_length[:, k, 0] = vy[(k + 1) % 4] - vy[k]
-        normal_length[:, k, 1] = vx[k] - vx[(k + 1) % 4]
     side_point = np.stack([np.where(ccw, h_near, v_near), np.where(ccw, v_far, h_far),
                            np.where(ccw, h_far, v_far), np.where(ccw, v_near, h_near)], axis=1)
     # The far sides are cell sides; a side through the node is one where the quadrant across
@@ -155,13 +152,11 @@ def grid_domains(xs: np.ndarray, ys: np.ndarray, slits: Sequence | None = (),
         number = np.cumsum(used) - 1
         side_point, boundary = number[side_point], replace(boundary, point=number[boundary.point])
     points = _placed_points(np.flatnonzero(used), total, coordinates, slit_points, shift)
-    cell_ptr = np.r_[0, np.cumsum(np.bincount(node, outer.sum(axis=1), n).astype(np.int64))]
     return NodalDomains(
         area=whole_area, second_moment=whole_moments,
         subcell_node=node, subcell_area=np.abs(a * b),
         subcell_centroid=np.column_stack([xn + 0.5 * a, yn + 0.5 * b]),
-        smoothing_points=points, subcell_point=side_point, subcell_normal_length=normal_length,
-        cell_ptr=cell_ptr, cell_point=side_point[outer], cell_normal_length=normal_length[outer],
+        smoothing_points=points, subcell_point=side_point, subcell_outer=outer,
         boundary=boundary, subcell_vertices=verts)
 
 

@@ -64,14 +64,12 @@ class HaloCounts:
 def _owned_points(domains: NodalDomains, x: np.ndarray, lo: int, hi: int, by_node: np.ndarray,
                   sub_ptr: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Evaluation points of particles ``lo:hi`` and the particle of each, as in
-    ``rkfx.parallel.ownership.nodal_integration_points`` (duplicates kept)."""
+    ``rkfx.parallel.ownership.nodal_integration_points`` (duplicates kept): the particles and
+    their subcells' smoothing points (which include their cells')."""
     d = domains
-    c0, c1 = d.cell_ptr[lo], d.cell_ptr[hi]
     subs = by_node[sub_ptr[lo]:sub_ptr[hi]]
-    points = np.concatenate([x[lo:hi], d.smoothing_points[d.cell_point[c0:c1]],
-                             d.smoothing_points[d.subcell_point[subs].ravel()]])
-    owner = np.concatenate([np.arange(lo, hi), np.repeat(np.arange(lo, hi), np.diff(d.cell_ptr[lo:hi + 1])),
-                            np.repeat(d.subcell_node[subs], d.subcell_point.shape[1])])
+    points = np.concatenate([x[lo:hi], d.smoothing_points[d.subcell_point[subs].ravel()]])
+    owner = np.concatenate([np.arange(lo, hi), np.repeat(d.subcell_node[subs], d.subcell_point.shape[1])])
     return points, owner
 
 

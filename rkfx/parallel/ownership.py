@@ -84,13 +84,12 @@ class Ownership:
 
 def nodal_integration_points(domains: NodalDomains, x: np.ndarray, nodes: np.ndarray) -> np.ndarray:
     """The points where nodal integration (SCNI, MSCNI) of the cells of ``nodes`` evaluates N,
-    shape ``(m, 2)``: the nodes, the smoothing points of their cells and subcells (which
-    include their boundary half-segment midpoints)."""
+    shape ``(m, 2)``: the nodes and the smoothing points of their subcells (which include
+    their cells' and their boundary half-segment midpoints)."""
     d = domains
     mine = np.zeros(len(d.area), bool)
     mine[nodes] = True
-    cells = np.repeat(mine, np.diff(d.cell_ptr))
-    used = np.unique(np.concatenate([d.cell_point[cells], d.subcell_point[mine[d.subcell_node]].ravel()]))
+    used = np.unique(d.subcell_point[mine[d.subcell_node]].ravel())
     return np.concatenate([x[nodes], d.smoothing_points[used]])
 
 
