@@ -22,6 +22,7 @@ from rkfx.geometry.particles import Particles
 from rkfx.integration.quadrature import NODAL_RULES, integration_rules, scni, subcell_rule
 from rkfx.parallel.ownership import numbering
 from rkfx.parallel.partition import rcb
+from rkfx.memory import ordinary_pages
 from rkfx.parallel.rows import owned_block, owned_entries, renumbered
 from rkfx.approximation.shape_functions import RKApproximation, evaluate, rk_approximation
 
@@ -143,6 +144,7 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, conditions: Sequ
     return ElasticSolution(rk, x[:2 * p.num_nodes].reshape(-1, 2), 2 * p.num_nodes, times, linear)
 
 
+@ordinary_pages()  # its arrays are temporaries (rkfx.memory)
 def elastic_terms(p: Particles, rk: RKApproximation, domains: NodalDomains, material: ElasticMaterial,
                   displacements: Sequence[Displacement], tractions: Sequence[Traction],
                   body_force: Callable[[np.ndarray], np.ndarray] | None, rule: str, bc_method: str,
