@@ -31,6 +31,22 @@ def test_serial_and_parallel_agree(tmp_path, script, ranks):
 
 @pytest.mark.mpi
 @pytest.mark.skipif(not MPIEXEC.exists() and shutil.which("mpiexec") is None, reason="no mpiexec")
+@pytest.mark.parametrize("ranks", [2, 3])
+def test_field_split_solves_alike_on_ranks(tmp_path, ranks):
+    """The field-split u-p solve (GMRES to a 1e-10 residual) on 1 rank and on 2 or 3: the same
+    pressures to the solver's tolerance (the ranks' rows change the preconditioner)."""
+    script = Path(__file__).parent / "mpi" / "solve_mandel_fieldsplit.py"
+    mpiexec = str(MPIEXEC) if MPIEXEC.exists() else "mpiexec"
+    serial, parallel = tmp_path / "serial.npy", tmp_path / "parallel.npy"
+    subprocess.run([sys.executable, str(script), str(serial)], check=True, timeout=300)
+    subprocess.run([mpiexec, "-n", str(ranks), sys.executable, str(script), str(parallel)], check=True, timeout=300)
+    a, b = np.load(serial), np.load(parallel)
+    assert a.shape == b.shape
+    assert np.abs(a - b).max() <= 1e-5 * np.abs(a).max()
+
+
+@pytest.mark.mpi
+@pytest.mark.skipif(not MPIEXEC.exists() and shutil.which("mpiexec") is None, reason="no mpiexec")
 @pytest.mark.parametrize("ranks", [1, 2, 3])
 def test_contributions_assemble_at_their_owners(ranks):
     """``UnknownShare.assemble`` and ``row_system`` give the whole vector and matrix rows."""

@@ -242,6 +242,83 @@ def transformation_constraints(p: Particles, rk: RKApproximation, conditions: Se
     return col.G, col.values(p.x, t)
 
 
+@dataclass(frozen=True)
+class NitscheRows:
+    """The rows at the boundary quadrature points of one condition's prescribed components,
+    component-major (all points of the first component, then of the next).
+
+    Attributes:
+        condition: The ``Displacement`` condition.
+        points: Its boundary quadrature points (indices into the ``BoundaryQuadrature``).
+        components: The prescribed components.
+        values: u_c(x_q) over the interleaved coefficients, shape ``(m nc, 2 n)``.
+        tractions: t_c(u)(x_q) = (T D B u)_c, the elastic traction, shape ``(m nc, 2 n)``.
+        weights: The points' weights, shape ``(m nc,)`` [m].
+        penalty: beta = penalty (lambda + 2 mu) / h, shape ``(m nc,)`` [Pa/m].
+        normals: n_c at each point, shape ``(m nc,)``.
+    """
+
+    condition: Displacement
+    points: np.ndarray
+    components: list[int]
+    values: sp.csr_matrix
+    tractions: sp.csr_matrix
+    weights: np.ndarray
+    penalty: np.ndarray
+    normals: np.ndarray
+
+    def matrix(self) -> sp.csr_matrix:
+        """-int(eta.t(u) + t(eta).u) + beta int(eta.u) over the prescribed components."""
+        w = sp.diags(self.weights)
+        return (-self.values.T @ w @ self.tractions - self.tractions.T @ w @ self.values
+                + self.values.T @ sp.diags(self.weights * self.penalty) @ self.values)
+
+    def load(self, bq: BoundaryQuadrature, t: float) -> np.ndarray:
+        """-int t(eta).u_bar + beta int eta.u_bar at time t, shape ``(2 n,)``."""
+        ubar = values(self.condition, bq.points[self.points], t).T.ravel()
+        return -self.tractions.T @ (self.weights * ubar) + self.values.T @ (self.weights * self.penalty * ubar)
+
+
+def nitsche_rows(p: Particles, bq: BoundaryQuadrature, d: np.ndarray, conditions: Sequence[Displacement],
+                 penalty: float = 100.0) -> list[NitscheRows]:
+    """The Nitsche rows of every condition with boundary points (``NitscheRows``).
+
+    Args:
+        d: Elasticity matrix (3, 3) [Pa] of the traction t(u) = T D B u.
+        conditions: ``rkfx.conditions.Displacement`` conditions, on their parts' boundary
+            quadrature points (``part_points``).
+        penalty: Dimensionless Nitsche parameter.
+    """
+    if not penalty > 0:
+        raise InputError(f"Nitsche penalty = {penalty!r} must be positive (e.g. 100)")
+    from rkfx.materials.elasticity import traction_operator  # noqa: PLC0415
+    from rkfx.assembly.operators import block_diagonal, strain_matrix  # noqa: PLC0415
+
+    n2 = 2 * p.num_nodes
+    grad = SparseRows(bq.rows.indptr, bq.rows.indices, bq.rows.data[:, 1:], bq.rows.num_cols)
+    b_all = strain_matrix(grad)
+    out = []
+    for bc in _only(conditions, (Displacement,), "nitsche_terms"):
+        sel = part_points(p, bq, bc.boundary)
+        if sel.size == 0:
+            continue
+        m = len(sel)
+        nmat = bq.rows.matrix(0)[sel]
+        # Displacement rows u_c(x_q) for the prescribed components c: (m * nc, 2n).
+        comps = list(bc.components)
+        proj = sp.vstack([sp.csr_matrix((nmat.data, nmat.indices * 2 + c, nmat.indptr), shape=(m, n2))
+                          for c in comps]).tocsr()
+        # Traction rows t_c(u)(x_q) = (T D B u)_c for the same components.
+        bq_rows = b_all[np.ravel(3 * sel[:, None] + np.arange(3))]
+        tdb = np.einsum("mij,jk->mik", traction_operator(bq.normals[sel]), d)
+        trac = block_diagonal(tdb) @ bq_rows  # (2 m, 2n), rows (q, component)
+        trac = sp.vstack([trac[c::2] for c in comps]).tocsr()
+        out.append(NitscheRows(bc, sel, comps, proj, trac, np.tile(bq.weights[sel], len(comps)),
+                               penalty * d[0, 0] / np.tile(bq.spacing[sel], len(comps)),
+                               np.concatenate([bq.normals[sel, c] for c in comps])))
+    return out
+
+
 def nitsche_terms(p: Particles, bq: BoundaryQuadrature, d: np.ndarray, conditions: Sequence[Displacement],
                   penalty: float = 100.0, t: float = 0.0) -> tuple[sp.csr_matrix, np.ndarray]:
     """Symmetric Nitsche matrix (2n, 2n) and load (2n,) for the prescribed components.
@@ -253,36 +330,24 @@ def nitsche_terms(p: Particles, bq: BoundaryQuadrature, d: np.ndarray, condition
         penalty: Dimensionless Nitsche parameter.
         t: Time [s].
     """
-    if not penalty > 0:
-        raise InputError(f"Nitsche penalty = {penalty!r} must be positive (e.g. 100)")
-    from rkfx.materials.elasticity import traction_operator  # noqa: PLC0415
-    from rkfx.assembly.operators import block_diagonal, strain_matrix  # noqa: PLC0415
-
     n2 = 2 * p.num_nodes
     k_total = sp.csr_matrix((n2, n2))
     f_total = np.zeros(n2)
-    grad = SparseRows(bq.rows.indptr, bq.rows.indices, bq.rows.data[:, 1:], bq.rows.num_cols)
-    b_all = strain_matrix(grad)
-    for bc in _only(conditions, (Displacement,), "nitsche_terms"):
-        sel = part_points(p, bq, bc.boundary)
-        if sel.size == 0:
-            continue
-        m = len(sel)
-        w = bq.weights[sel]
-        nmat = bq.rows.matrix(0)[sel]
-        # Displacement rows u_c(x_q) for the prescribed components c: (m * nc, 2n).
-        comps = list(bc.components)
-        proj = sp.vstack([sp.csr_matrix((nmat.data, nmat.indices * 2 + c, nmat.indptr), shape=(m, n2))
-                          for c in comps]).tocsr()
-        # Traction rows t_c(u)(x_q) = (T D B u)_c for the same components.
-        bq_rows = b_all[np.ravel(3 * sel[:, None] + np.arange(3))]
-        tdb = np.einsum("mij,jk->mik", traction_operator(bq.normals[sel]), d)
-        trac = block_diagonal(tdb) @ bq_rows  # (2 m, 2n), rows (q, component)
-        trac = sp.vstack([trac[c::2] for c in comps]).tocsr()
-        wc = np.tile(w, len(comps))
-        beta = penalty * d[0, 0] / np.tile(bq.spacing[sel], len(comps))
-        wmat = sp.diags(wc)
-        k_total = k_total - proj.T @ wmat @ trac - trac.T @ wmat @ proj + proj.T @ sp.diags(wc * beta) @ proj
-        ubar = values(bc, bq.points[sel], t).T.ravel()
-        f_total += -trac.T @ (wc * ubar) + proj.T @ (wc * beta * ubar)
+    for rows in nitsche_rows(p, bq, d, conditions, penalty):
+        k_total = k_total + rows.matrix()
+        f_total += rows.load(bq, t)
     return k_total.tocsr(), f_total
+
+
+def nitsche_pressure_coupling(bq: BoundaryQuadrature, rows: Sequence[NitscheRows], alpha: float) -> sp.csr_matrix:
+    """C = int_Gamma_u alpha p eta_c n_c over the prescribed components, shape ``(2 n, n)``:
+    the pore-pressure part of the total traction (sigma'' - alpha p I) n in Nitsche's
+    consistency term -int eta.(sigma n) of the u-p equations (the momentum rows then hold
+    -(K_up - C) p)."""
+    n = bq.rows.num_cols
+    total = sp.csr_matrix((2 * n, n))
+    nmat = bq.rows.matrix(0)
+    for r in rows:
+        at = sp.vstack([nmat[r.points]] * len(r.components)).tocsr()
+        total = total + r.values.T @ sp.diags(alpha * r.weights * r.normals) @ at
+    return total.tocsr()

@@ -9,6 +9,7 @@ a distributed system) is solved on local vectors: its owned entries go to PETSc,
 solution comes back with the ghost entries filled by their owners.
 """
 from collections.abc import Mapping
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
@@ -17,7 +18,32 @@ from rkfx.errors import InputError
 from rkfx.parallel.unknowns import RowSystem
 
 # The PETSc solvers by name (``rkfx.linalg.petsc.make_ksp``).
-SOLVERS = ("mumps", "gmres-ilu", "cg-gamg")
+SOLVERS = ("mumps", "gmres-ilu", "cg-gamg", "fieldsplit")
+
+
+@dataclass(frozen=True)
+class DisplacementSplit:
+    """The block structure that the ``fieldsplit`` solver preconditions: the first 2 n unknowns
+    are the displacements, interleaved per node; the others (pressures, multipliers of
+    collocated conditions) form the second block.
+
+    Attributes:
+        coordinates: The n nodes, shape ``(n, 2)`` [m]: their rigid-body modes are the near
+            null space of the displacement block's multigrid.
+        fixed_stress: The fixed-stress estimate of the coupling's share of the pressure Schur
+            complement, alpha^2 / K_dr int N_I (K_dr the drained bulk modulus), per pressure
+            unknown, shape ``(n,)``; the second block's own diagonal block, so shifted (away
+            from zero, in its sign), preconditions the Schur complement. ``None``: PETSc's
+            A_pp - A_pu diag(A_uu)^-1 A_up.
+    """
+
+    coordinates: np.ndarray
+    fixed_stress: np.ndarray | None = None
+
+    @property
+    def size(self) -> int:
+        """The displacement unknowns, 2 n."""
+        return 2 * len(self.coordinates)
 
 
 class _ScipyLU:
@@ -76,7 +102,8 @@ class _RowSystemSolver:
 
 
 def linear_solver(a: sp.spmatrix, comm=None, solver: str = "mumps", mumps_icntl: Mapping[int, int] | None = None,
-                  owned_rows: bool = False, coordinates: np.ndarray | None = None):
+                  owned_rows: bool = False, coordinates: np.ndarray | None = None,
+                  split: DisplacementSplit | None = None):
     """An object with ``.solve(b)``, ``.destroy()`` and its last solve's ``.iterations`` and
     ``.reason`` for the matrix ``a`` (``mumps_icntl``:
     further MUMPS controls, see ``rkfx.linalg.petsc.make_ksp``; ignored without PETSc).
@@ -84,9 +111,17 @@ def linear_solver(a: sp.spmatrix, comm=None, solver: str = "mumps", mumps_icntl:
     ``owned_rows``: ``a`` and every ``b`` are this rank's block of rows of a distributed system
     (``rkfx.parallel.rows.owned_block``); ``solve`` still returns the whole solution.
     ``coordinates``: the nodes of this rank's rows of a 2-D displacement system, for the
-    rigid-body modes of ``cg-gamg`` (see ``rkfx.linalg.petsc.make_ksp``)."""
+    rigid-body modes of ``cg-gamg`` (see ``rkfx.linalg.petsc.make_ksp``). ``split``: the
+    blocks of ``fieldsplit`` (required by it)."""
     if solver == "serial":
         return _ScipyLU(a)
+    if solver == "fieldsplit" and split is None:
+        raise InputError("solver='fieldsplit' needs its displacement block: pass split=DisplacementSplit(coordinates)")
+    if split is not None and solver != "fieldsplit":
+        raise InputError(f"split= is for solver='fieldsplit', not {solver!r}")
+    if split is not None and (owned_rows or isinstance(a, RowSystem)):
+        raise InputError("solver='fieldsplit' takes the whole system on every rank; solve with distributed=False, "
+                         "or use solver='mumps' on distributed rows")
     if isinstance(a, RowSystem):
         try:
             return _RowSystemSolver(a, comm if comm is not None else a.share.comm, solver, mumps_icntl)
@@ -99,7 +134,7 @@ def linear_solver(a: sp.spmatrix, comm=None, solver: str = "mumps", mumps_icntl:
             raise InputError(f"solver {solver!r}{' on distributed rows' * owned_rows} needs PETSc: pip install 'rkfx[fem]'") from None
         return _ScipyLU(a)
     return petsc.LinearSolver(a, comm if comm is not None else petsc.MPI.COMM_WORLD, solver, mumps_icntl, owned_rows,
-                              coordinates)
+                              coordinates, split=split)
 
 
 
@@ -122,11 +157,12 @@ class Factorizations:
     """
 
     def __init__(self, comm=None, solver: str = "mumps", keep: int = 5, mumps_icntl: Mapping[int, int] | None = None,
-                 reuse_analysis: bool = False):
+                 reuse_analysis: bool = False, split: DisplacementSplit | None = None):
         self.comm, self.solver, self.keep, self.mumps_icntl = comm, solver, int(keep), mumps_icntl
-        self.reuse_analysis = reuse_analysis
+        self.reuse_analysis, self.split = reuse_analysis, split
         self._cache: dict = {}
         self.count = 0  # factorizations made
+        self._retired = [0, 0]  # solves and Krylov iterations of the solvers freed so far
         # Set-up that steppers reuse from step to step of one run (keyed by the stepper).
         self.memo: dict = {}
 
@@ -147,7 +183,7 @@ class Factorizations:
                 del self._cache[old]
                 self._cache[key] = spare
             return spare
-        ls = linear_solver(a, self.comm, self.solver, self.mumps_icntl)
+        ls = linear_solver(a, self.comm, self.solver, self.mumps_icntl, split=self.split)
         self.count += 1
         if key is None:
             self._drop(None)
@@ -156,12 +192,18 @@ class Factorizations:
         self._cache[key] = ls
         return ls
 
+    def linear_iterations(self) -> tuple[int, int]:
+        """(solves, Krylov iterations) over every solver this object made (1 per direct solve)."""
+        live = [(getattr(ls, "solves", 0), getattr(ls, "total_iterations", 0)) for ls in self._cache.values()]
+        return self._retired[0] + sum(a for a, _ in live), self._retired[1] + sum(b for _, b in live)
+
     def _drop(self, key) -> None:
         old = self._cache.pop(key, None)
         if old is not None:
+            self._retired[0] += getattr(old, "solves", 0)
+            self._retired[1] += getattr(old, "total_iterations", 0)
             old.destroy()
 
     def destroy(self) -> None:
-        for ls in self._cache.values():
-            ls.destroy()
-        self._cache.clear()
+        for key in list(self._cache):
+            self._drop(key)

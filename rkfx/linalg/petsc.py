@@ -17,13 +17,13 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from rkfx.errors import InputError, SolverError
-from rkfx.linalg.linear_solver import SOLVERS
+from rkfx.linalg.linear_solver import SOLVERS, DisplacementSplit
 from rkfx.linalg.symmetry import is_symmetric
 
 # Relative residual at which the Krylov solvers stop. CG + GAMG stops at 1e-8: on Timoshenko's
 # beam (bench/beam_scale.py, 263k nodes) the displacement error is the same to three digits
 # as at 1e-12 (4.5e-6), in 25 iterations instead of 40.
-RTOL = {"gmres-ilu": 1e-12, "cg-gamg": 1e-8}
+RTOL = {"gmres-ilu": 1e-12, "cg-gamg": 1e-8, "fieldsplit": 1e-10}
 
 # GAMG drops the graph edges weaker than this before it aggregates: with 0.02 the iterations on
 # the beam stay at 11-14 from 10^3 to 10^6 nodes (PETSc's default: 33 at 16k, 40 at 263k).
@@ -44,12 +44,20 @@ class SolverDiverged(SolverError):
     """A PETSc linear solve did not converge."""
 
 
-def to_petsc_mat(a: sp.spmatrix, comm=MPI.COMM_WORLD) -> PETSc.Mat:
-    """Distributed AIJ matrix from a global scipy sparse matrix held on every rank."""
+def to_petsc_mat(a: sp.spmatrix, comm=MPI.COMM_WORLD, even_below: int = 0) -> PETSc.Mat:
+    """Distributed AIJ matrix from a global scipy sparse matrix held on every rank.
+
+    ``even_below``: no rank's rows start at an odd row below this one (the interleaved
+    displacement pairs of the first ``even_below`` rows stay on one rank)."""
     a = _sorted_csr(a)
     n_rows, n_cols = a.shape
     mat = PETSc.Mat().create(comm=comm)
-    mat.setSizes(((PETSc.DECIDE, n_rows), (PETSc.DECIDE, n_cols)))
+    local = PETSc.DECIDE
+    if even_below and comm.size > 1:
+        cuts = [n_rows * r // comm.size for r in range(comm.size + 1)]
+        cuts = [c + (c % 2 if c < even_below else 0) for c in cuts]
+        local = cuts[comm.rank + 1] - cuts[comm.rank]
+    mat.setSizes(((local, n_rows), (local, n_cols)))
     mat.setType(PETSc.Mat.Type.AIJ)
     mat.setUp()
     mat.setPreallocationCSR(_owned_rows(a, mat))
@@ -111,8 +119,10 @@ def gather(vec: PETSc.Vec) -> np.ndarray:
 
 def make_ksp(mat: PETSc.Mat, solver: str = "mumps", rtol: float | None = None, prefix: str = "rkfx_",
              mumps_icntl: Mapping[int, int] | None = None, coordinates: np.ndarray | None = None,
-             symmetric: bool = False) -> PETSc.KSP:
-    """A KSP for ``mat``: MUMPS LU (default), GMRES with ILU/ASM, or CG with GAMG.
+             symmetric: bool = False, split: DisplacementSplit | None = None,
+             whole: sp.csr_matrix | None = None) -> PETSc.KSP:
+    """A KSP for ``mat``: MUMPS LU (default), GMRES with ILU/ASM, CG with GAMG, or GMRES
+    with a Schur-complement field split (``fieldsplit``, ``_field_split``).
 
     ``symmetric`` (mumps): ``mat`` equals its transpose, and MUMPS factorizes it as L D L^T
     with pivoting (its symmetric indefinite mode), from the upper triangle only.
@@ -151,18 +161,103 @@ def make_ksp(mat: PETSc.Mat, solver: str = "mumps", rtol: float | None = None, p
         ksp.setType("gmres")
         pc.setType("asm" if mat.getComm().size > 1 else "ilu")
         ksp.setTolerances(rtol=rtol, max_it=10000)
+    elif solver == "fieldsplit":
+        if split is None:
+            raise InputError("solver='fieldsplit' needs split=DisplacementSplit(coordinates)")
+        _field_split(ksp, mat, split, rtol, prefix, whole)
     else:
         ksp.setType("cg")
         pc.setType("gamg")
         ksp.setTolerances(rtol=rtol, max_it=10000)
-        options = PETSc.Options(prefix)
-        for name, value in (("pc_gamg_threshold", GAMG_THRESHOLD), ("mg_levels_ksp_max_it", GAMG_SMOOTHING_STEPS)):
-            if not options.hasName(name):
-                options.setValue(name, value)
+        _gamg_defaults(prefix)
         if coordinates is not None:
             _rigid_body_modes(mat, coordinates)
     ksp.setFromOptions()
     return ksp
+
+
+def _gamg_defaults(prefix: str) -> None:
+    """GAMG_THRESHOLD and GAMG_SMOOTHING_STEPS under ``prefix``, unless the user set them."""
+    options = PETSc.Options(prefix)
+    for name, value in (("pc_gamg_threshold", GAMG_THRESHOLD), ("mg_levels_ksp_max_it", GAMG_SMOOTHING_STEPS)):
+        if not options.hasName(name):
+            options.setValue(name, value)
+
+
+def _field_split(ksp: PETSc.KSP, mat: PETSc.Mat, split: DisplacementSplit, rtol: float, prefix: str,
+                 a: sp.csr_matrix | None = None) -> None:
+    """GMRES on [[A_uu, A_up], [A_pu, A_pp]] (u: the first ``split.size`` rows), preconditioned
+    by the full Schur factorization: A_uu by one V-cycle of smoothed aggregation (GAMG, the
+    nodes' rigid-body modes as near null space), the Schur complement through the fixed-stress
+    approximation A_pp -+ alpha^2 / K_dr int N_I (``DisplacementSplit.fixed_stress``, with the
+    whole matrix ``a`` held on every rank) or else PETSc's A_pp - A_pu diag(A_uu)^-1 A_up
+    ("selfp", poor for RK's overlapping supports), factorized by MUMPS. The second block, the
+    pressures (and multipliers), is a scalar field: a third of the unknowns and a fraction of
+    the fill of the whole system's LU. GMRES is preconditioned on the right, so that it stops
+    on the true residual. Options under ``-rkfx_fieldsplit_u_`` and ``-rkfx_fieldsplit_p_``
+    refine either block."""
+    comm = mat.getComm()
+    lo, hi = mat.getOwnershipRange()
+    n_u = split.size
+    u_lo, u_hi = min(lo, n_u), min(hi, n_u)
+    if u_lo % 2:
+        raise InputError("fieldsplit: a rank's rows begin inside a node's displacement pair; build the matrix "
+                         "with to_petsc_mat(..., even_below=2 n)")
+    is_u = PETSc.IS().createStride(u_hi - u_lo, u_lo, 1, comm=comm)
+    p_lo = min(max(lo, n_u), hi)
+    is_p = PETSc.IS().createStride(hi - p_lo, p_lo, 1, comm=comm)
+    x = np.ascontiguousarray(split.coordinates[u_lo // 2:u_hi // 2], dtype=PETSc.ScalarType)
+    modes = PETSc.Vec().createMPI((u_hi - u_lo, PETSc.DECIDE), bsize=2, comm=comm)
+    modes.array[:] = x.ravel()
+    is_u.setBlockSize(2)
+    is_u.compose("nearnullspace", PETSc.NullSpace().createRigidBody(modes))
+    modes.destroy()
+    ksp.setType("gmres")
+    ksp.setGMRESRestart(100)
+    ksp.setPCSide(PETSc.PC.Side.RIGHT)
+    ksp.setTolerances(rtol=rtol, max_it=1000)
+    pc = ksp.getPC()
+    pc.setType("fieldsplit")
+    pc.setFieldSplitIS(("u", is_u), ("p", is_p))
+    pc.setFieldSplitType(PETSc.PC.CompositeType.SCHUR)
+    pc.setFieldSplitSchurFactType(PETSc.PC.FieldSplitSchurFactType.FULL)
+    if split.fixed_stress is not None and a is not None:
+        a11 = sp.csr_matrix(a[n_u:, n_u:])
+        shift = np.zeros(a11.shape[0])
+        m = len(split.fixed_stress)
+        pp = a11.diagonal()[:m]
+        shift[:m] = np.where(pp < 0, -1.0, 1.0) * np.asarray(split.fixed_stress, float)
+        schur = _block_mat(a11 + sp.diags(shift), is_p, n_u, comm)
+        pc.setFieldSplitSchurPreType(PETSc.PC.FieldSplitSchurPreType.USER, schur)
+        schur.destroy()  # the PC holds its own reference
+    else:
+        pc.setFieldSplitSchurPreType(PETSc.PC.FieldSplitSchurPreType.SELFP)
+    options = PETSc.Options(prefix)
+    for name, value in (("fieldsplit_u_ksp_type", "preonly"), ("fieldsplit_u_pc_type", "gamg"),
+                        ("fieldsplit_p_ksp_type", "preonly"), ("fieldsplit_p_pc_type", "lu"),
+                        ("fieldsplit_p_pc_factor_mat_solver_type", "mumps"),
+                        ("fieldsplit_p_mat_mumps_icntl_14", 200)):
+        if not options.hasName(name):
+            options.setValue(name, value)
+    _gamg_defaults(prefix + "fieldsplit_u_")
+
+
+def _block_mat(block: sp.csr_matrix, rows: PETSc.IS, first: int, comm) -> PETSc.Mat:
+    """The AIJ matrix of a diagonal block held whole on every rank, whose global rows begin at
+    ``first``; each rank takes the rows of ``rows`` (its contiguous range of them)."""
+    block = _sorted_csr(block)
+    m = rows.getLocalSize()
+    lo = rows.getIndices()[0] - first if m else 0
+    mat = PETSc.Mat().create(comm=comm)
+    mat.setSizes(((m, block.shape[0]), (m, block.shape[1])))
+    mat.setType(PETSc.Mat.Type.AIJ)
+    mat.setUp()
+    ptr = block.indptr[lo:lo + m + 1]
+    mat.setPreallocationCSR(((ptr - ptr[0]).astype(PETSc.IntType),
+                             block.indices[ptr[0]:ptr[-1]].astype(PETSc.IntType),
+                             block.data[ptr[0]:ptr[-1]].astype(PETSc.ScalarType)))
+    mat.assemble()
+    return mat
 
 
 def _rigid_body_modes(mat: PETSc.Mat, coordinates: np.ndarray) -> None:
@@ -190,7 +285,8 @@ class LinearSolver:
 
     def __init__(self, a: sp.spmatrix, comm=MPI.COMM_WORLD, solver: str = "mumps",
                  mumps_icntl: Mapping[int, int] | None = None, owned_rows: bool = False,
-                 coordinates: np.ndarray | None = None, symmetric: bool = False):
+                 coordinates: np.ndarray | None = None, symmetric: bool = False,
+                 split: DisplacementSplit | None = None):
         self.solver, self.owned_rows = solver, owned_rows
         a = _sorted_csr(a)
         if owned_rows:  # a is this rank's block of rows (owned_rows_mat); b is too
@@ -198,14 +294,14 @@ class LinearSolver:
             self.mat = owned_rows_mat(a, comm)
         else:
             self.pattern = (a.shape, a.indptr.copy(), a.indices.copy())
-            self.mat = to_petsc_mat(a, comm)
+            self.mat = to_petsc_mat(a, comm, even_below=0 if split is None else split.size)
         # symmetric=True: L D L^T for a matrix that is (``is_symmetric``), whole on every rank.
         # Not the default: on the saddle points of the transformation method (zero diagonal
         # block) MUMPS's pivoting L D L^T took 36.9 s where LU took 4.2 s (Sneddon, 99,844
         # unknowns); on Mandel's u-p steps it saved memory (docs/verification.md).
         self.symmetric = symmetric and solver == "mumps" and not owned_rows and is_symmetric(a)
         self.ksp = make_ksp(self.mat, solver, mumps_icntl=mumps_icntl, coordinates=coordinates,
-                            symmetric=self.symmetric)
+                            symmetric=self.symmetric, split=split, whole=a if split is not None else None)
         self.rhs = self.mat.createVecLeft()
         self.x = self.mat.createVecRight()
         self.residual = self.mat.createVecLeft()
@@ -213,6 +309,7 @@ class LinearSolver:
         self._warned = False
         self.iterations = 0  # Krylov iterations of the last solve (1 for a direct solve)
         self.reason = ""  # PETSc's name of why the last solve stopped
+        self.solves = self.total_iterations = 0  # over this solver's life
 
     def solve(self, b: np.ndarray, whole: bool = True) -> np.ndarray:
         """The whole solution on every rank (``b``: the whole right-hand side, or this rank's
@@ -230,6 +327,8 @@ class LinearSolver:
         reason = self.ksp.getConvergedReason()
         self.iterations = max(self.ksp.getIterationNumber(), 1 if self.solver == "mumps" else 0)
         self.reason = _REASONS.get(reason, str(reason))
+        self.solves += 1
+        self.total_iterations += self.iterations
         if reason < 0:
             raise SolverDiverged(f"PETSc solver {self.solver!r} diverged (KSPConvergedReason {reason}) after "
                                  f"{self.ksp.getIterationNumber()} iterations; try solver='mumps' or check the "
@@ -255,7 +354,7 @@ class LinearSolver:
 
     def matches(self, a: sp.spmatrix) -> bool:
         """Whether ``a`` has this system's sparsity pattern (so ``refactor`` may take it)."""
-        if self.pattern is None:
+        if self.pattern is None or self.solver == "fieldsplit":  # its Schur preconditioner is built once
             return False
         a = _sorted_csr(a)
         shape, indptr, indices = self.pattern

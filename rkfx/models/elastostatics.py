@@ -33,7 +33,7 @@ from rkfx.approximation.shape_functions import RKApproximation, evaluate, rk_app
 # and 0.14 s at 8.5k, 1.2 s and 0.52 s at 33k, 10.8 s and 2.2 s at 132k: below the switch both
 # are fast and the direct solve is the robust one; above it the fill of LU costs time and memory.
 AUTO_DIRECT_MAX_DOFS = 10_000
-SOLVER_CHOICES = ("auto", *SOLVERS)
+SOLVER_CHOICES = ("auto", *(s for s in SOLVERS if s != "fieldsplit"))  # fieldsplit: for u-p blocks
 
 
 def choose_solver(solver: str, n_dofs: int, bc_method: str, rule: str) -> str:

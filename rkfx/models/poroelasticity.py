@@ -34,14 +34,15 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from rkfx.assembly.boundary import (BoundaryQuadrature, Collocation, boundary_quadrature, collocation, part_points,
-                                   traction_values)
+from rkfx.assembly.boundary import (BC_METHODS, BoundaryQuadrature, Collocation, boundary_quadrature, collocation,
+                                   nitsche_pressure_coupling, nitsche_rows, part_points, traction_values)
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.conditions import Displacement, Flux, Pressure, Traction, values
 from rkfx.errors import InputError
 from rkfx.geometry.nodal_domains import NodalDomains, nodal_domains
 from rkfx.assembly.operators import laplacian, mass, stiffness
 from rkfx.geometry.particles import Particles
+from rkfx.linalg.linear_solver import DisplacementSplit, Factorizations
 from rkfx.integration.quadrature import Quadrature, dni, mscni_rules, scni, selected_cells
 from rkfx.approximation.shape_functions import RKApproximation, evaluate, rk_approximation
 from rkfx.parallel.ownership import numbering
@@ -313,6 +314,9 @@ class BiotSolution:
         n_dofs: Unknowns per step (3 n).
         wall_time_s: Assembly plus time stepping [s].
         steps: Number of time steps taken.
+        timings: Wall times of the stages [s].
+        linear: The linear solver, its ``solves`` and their Krylov ``iterations`` in all
+            (1 per direct solve).
     """
 
     rk: RKApproximation
@@ -323,6 +327,7 @@ class BiotSolution:
     wall_time_s: float
     steps: int
     timings: dict[str, float] = field(default_factory=dict)
+    linear: dict = field(default_factory=dict)
 
     def pressure(self, points: np.ndarray) -> np.ndarray:
         """p^h at points for every output time, shape ``(k, m)`` [Pa]."""
@@ -351,10 +356,15 @@ class BiotModel(Stateless):
     Kup^T u' + S p' + Kh p = Q^ext. S(dt) is the compressibility plus the rate-form projection
     stabilization (3.60), whose eps_f (3.53) depends on the step size.
 
+    With ``nitsche`` (K_N, C) the displacement conditions are imposed by Nitsche's method
+    instead of collocation: the momentum rows hold (Kuu + K_N) u - (Kup - C) p, C the
+    pore-pressure part of the total traction in the consistency term; the storage rows keep
+    Kup^T u' (the Jacobian is then not symmetric).
+
     Attributes:
         operators: The matrices of one discretization.
         material: Poroelastic constants.
-        collocation: Collocated essential conditions of u and p.
+        collocation: Collocated essential conditions (of u and p, or of p alone with Nitsche).
         nodes: Node coordinates at which the conditions are collocated, shape ``(n, 2)`` [m].
         loads: F^ext(t), Q^ext(t) as ``(2 n,)`` and ``(n,)`` arrays.
         local: On MPI ranks, the rank's local unknowns (``rkfx.parallel.unknowns``): the
@@ -364,7 +374,8 @@ class BiotModel(Stateless):
 
     def __init__(self, operators: BiotOperators, material: PoroMaterial, col: Collocation,
                  nodes: np.ndarray, loads: Callable[[float], tuple[np.ndarray, np.ndarray]],
-                 local: LocalUnknowns | None = None):
+                 local: LocalUnknowns | None = None,
+                 nitsche: tuple[sp.csr_matrix, sp.csr_matrix] | None = None):
         self.operators, self.material, self.collocation, self.loads = operators, material, col, loads
         self.nodes, self.local = nodes, local
         self.share = None if local is None else local.share
@@ -372,7 +383,10 @@ class BiotModel(Stateless):
         self.layout = layout(("u", 2, 1), ("p", 1, 1), nodes=n)
         self.linear = True
         o = operators
-        self._K = self._local(sp.bmat([[o.Kuu, -o.Kup], [None, o.Kh]], format="csr"))
+        kuu, kup = o.Kuu, o.Kup
+        if nitsche is not None:  # Nitsche's terms of the displacement conditions (``biot_nitsche``)
+            kuu, kup = kuu + nitsche[0], kup - nitsche[1]
+        self._K = self._local(sp.bmat([[kuu, -kup], [None, o.Kh]], format="csr"))
         self._G = col.G if local is None else col.G[:, local.index].tocsr()
         self._per_step = PerStepSize(keep=5)
         self._n = n
@@ -477,7 +491,8 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
                comm=None, solver: str = "mumps", progress: Callable | None = None,
                rk: RKApproximation | None = None, domains: NodalDomains | None = None,
                fields: NodalFields | None = None, checkpoint_every: int = 0, checkpoint_dir=None,
-               resume=None, distributed: bool | None = None) -> BiotSolution:
+               resume=None, distributed: bool | None = None, bc_method: str = "transformation",
+               nitsche_penalty: float = 100.0) -> BiotSolution:
     """Solve the u-p equations by backward Euler on the step times ``times`` (t_0 = 0).
 
     Initial state u = 0, p = 0. Loads and prescribed values are evaluated at t_{n+1} (3.39)-(3.40).
@@ -509,6 +524,11 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
             assembled by owned rows (``rkfx.parallel.unknowns``), and the checkpoints are one
             per rank. ``None`` (default): when ``comm`` has more than one rank. The solution is
             gathered on every rank at the end.
+        bc_method: How the displacement conditions are imposed: ``transformation``
+            (collocated at the boundary nodes, by multipliers) or ``nitsche`` (Nitsche's method
+            with the total traction, no multipliers: what an iterative solver of the u block
+            needs, see ``rkfx.linalg.petsc``). Pressures are collocated either way.
+        nitsche_penalty: Dimensionless Nitsche parameter (``rkfx.assembly.boundary``).
     """
     t_all = np.asarray(times, float)
     if t_all[0] != 0.0 or np.any(np.diff(t_all) <= 0):
@@ -520,6 +540,15 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
         raise InputError("every output time must be one of the step times (use rkfx.solvers.integrate.time_grid)")
     if not (displacements or pressures):
         raise InputError("no essential boundary conditions: prescribe displacements (and pressures)")
+    if bc_method not in BC_METHODS:
+        raise InputError(f"unknown bc_method {bc_method!r}; choose one of {', '.join(BC_METHODS)}")
+    nitsche = bc_method == "nitsche"
+    if solver == "fieldsplit" and not nitsche:
+        raise InputError("solver='fieldsplit' preconditions the displacement block by multigrid, which needs the "
+                         "displacement conditions in it: use bc_method='nitsche'")
+    if nitsche and fields is not None and (fields.D is not None or fields.alpha is not None):
+        raise InputError("bc_method='nitsche' takes the material's constant D and alpha on the boundary; per-particle "
+                         "fields D or alpha need bc_method='transformation'")
     if distributed is None:
         distributed = comm is not None and comm.size > 1
     elif distributed and comm is None:
@@ -538,7 +567,13 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
         segments = np.flatnonzero(np.isin(d.boundary.node, mine))
     ops = biot_operators(p, rk, d, material, variant, fields=fields, nodes=mine)
     bq = boundary_quadrature(p, d, rk, segments=segments)
-    col = collocation(p, rk, [(displacements, 0, 2), (pressures, 2 * n, 1)], 3 * n, nodes=mine)
+    collocated = [(pressures, 2 * n, 1)] if nitsche else [(displacements, 0, 2), (pressures, 2 * n, 1)]
+    col = collocation(p, rk, collocated, 3 * n, nodes=mine)
+    weak = nitsche_rows(p, bq, material.elastic.D(), displacements, nitsche_penalty) if nitsche else []
+    boundary_terms = None
+    if nitsche:
+        boundary_terms = (sum((r.matrix() for r in weak), sp.csr_matrix((2 * n, 2 * n))).tocsr(),
+                          nitsche_pressure_coupling(bq, weak, material.alpha))
     nb = bq.rows.matrix(0)
     # Gravity (3.36)-(3.37), integrated at the nodes like the other nodal terms.
     f_gravity, q_gravity = np.zeros(2 * n), np.zeros(n)
@@ -556,20 +591,36 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
 
     def loads(t):
         f, q = boundary(t)
+        for r in weak:  # Nitsche's terms of the prescribed displacements
+            f = f + r.load(bq, t)
         return f + f_gravity, q + q_gravity  # F^ext (3.36) and Q^ext (3.37)
 
     local = None
     if distributed:
         # The nodes this rank's terms touch: its own and the ghosts (stiffness, coupling,
         # storage with the projection pattern, collocation rows, boundary loads).
-        whole = sp.bmat([[ops.Kuu, -ops.Kup], [ops.Kup.T, ops.Ks + ops.stabilization(np.ones(n))]], format="csr")
+        kuu, kup = (ops.Kuu, ops.Kup) if boundary_terms is None else (ops.Kuu + boundary_terms[0],
+                                                                     ops.Kup + boundary_terms[1])
+        whole = sp.bmat([[kuu, -kup], [ops.Kup.T, ops.Ks + ops.stabilization(np.ones(n))]], format="csr")
         touched = touched_nodes((2, 1), n, whole, col.G)
         local = local_unknowns(num, np.unique(np.r_[touched, nb.indices, mine]), (2, 1), comm)
-    model = BiotModel(ops, material, col, p.x, loads, local)
+    model = BiotModel(ops, material, col, p.x, loads, local, nitsche=boundary_terms)
     kept = _Outputs(wanted, n, local)
-    integrate(backward_euler(), model, t_all, recorder=kept, comm=comm, solver=solver,
-                    progress=progress, max_cuts=0, checkpoint_every=checkpoint_every,
-                    checkpoint_dir=checkpoint_dir, resume=resume)
+    split = None
+    if solver == "fieldsplit":
+        # Fixed stress: the coupling's share of the pressure Schur complement, alpha^2 / K_dr
+        # int N_I with K_dr = lambda + mu of plane strain and int N_I = A_I (partition of unity).
+        lam, mu = material.elastic.lame
+        split = DisplacementSplit(p.x, material.alpha**2 / (lam + mu) * d.area)
+    solves = Factorizations(comm, solver, split=split)
+    try:
+        integrate(backward_euler(), model, t_all, recorder=kept, comm=comm, solves=solves,
+                  progress=progress, max_cuts=0, checkpoint_every=checkpoint_every,
+                  checkpoint_dir=checkpoint_dir, resume=resume)
+    finally:
+        solves.destroy()
     timings["steps"] = time.perf_counter() - t0
+    count, iterations = solves.linear_iterations()
     U, P = kept.whole()
-    return BiotSolution(rk, wanted, U, P, 3 * n, sum(timings.values()), len(t_all) - 1, timings)
+    return BiotSolution(rk, wanted, U, P, 3 * n, sum(timings.values()), len(t_all) - 1, timings,
+                        {"solver": solver, "solves": count, "iterations": iterations})
