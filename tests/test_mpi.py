@@ -19,6 +19,12 @@ MPIEXEC = Path(sys.executable).parent / "mpiexec"
 def test_serial_and_parallel_agree(tmp_path, script, ranks):
     """Elastostatics on gmsh nodes (manufactured solution, patch test) and a u-p time loop:
     the same answer on 1 rank and on 2 or 3."""
+    a, b = _serial_and_parallel(tmp_path, script, ranks)
+    assert np.abs(a - b).max() <= 1e-10 * np.abs(a).max()
+
+
+def _serial_and_parallel(tmp_path, script: str, ranks: int) -> tuple[np.ndarray, np.ndarray]:
+    """What ``tests/mpi/<script> OUT.npy`` saves run serially and on ``ranks`` ranks (same shape)."""
     script = Path(__file__).parent / "mpi" / script
     mpiexec = str(MPIEXEC) if MPIEXEC.exists() else "mpiexec"
     serial, parallel = tmp_path / "serial.npy", tmp_path / "parallel.npy"
@@ -26,7 +32,7 @@ def test_serial_and_parallel_agree(tmp_path, script, ranks):
     subprocess.run([mpiexec, "-n", str(ranks), sys.executable, str(script), str(parallel)], check=True, timeout=300)
     a, b = np.load(serial), np.load(parallel)
     assert a.shape == b.shape
-    assert np.abs(a - b).max() <= 1e-10 * np.abs(a).max()
+    return a, b
 
 
 @pytest.mark.mpi
@@ -35,13 +41,7 @@ def test_serial_and_parallel_agree(tmp_path, script, ranks):
 def test_field_split_solves_alike_on_ranks(tmp_path, ranks):
     """The field-split u-p solve (GMRES to a 1e-10 residual) on 1 rank and on 2 or 3: the same
     pressures to the solver's tolerance (the ranks' rows change the preconditioner)."""
-    script = Path(__file__).parent / "mpi" / "solve_mandel_fieldsplit.py"
-    mpiexec = str(MPIEXEC) if MPIEXEC.exists() else "mpiexec"
-    serial, parallel = tmp_path / "serial.npy", tmp_path / "parallel.npy"
-    subprocess.run([sys.executable, str(script), str(serial)], check=True, timeout=300)
-    subprocess.run([mpiexec, "-n", str(ranks), sys.executable, str(script), str(parallel)], check=True, timeout=300)
-    a, b = np.load(serial), np.load(parallel)
-    assert a.shape == b.shape
+    a, b = _serial_and_parallel(tmp_path, "solve_mandel_fieldsplit.py", ranks)
     assert np.abs(a - b).max() <= 1e-5 * np.abs(a).max()
 
 
