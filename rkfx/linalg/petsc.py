@@ -189,8 +189,9 @@ def _field_split(ksp: PETSc.KSP, mat: PETSc.Mat, split: DisplacementSplit, rtol:
     """GMRES on [[A_uu, A_up], [A_pu, A_pp]] (u: the first ``split.size`` rows), preconditioned
     by the full Schur factorization: A_uu by one V-cycle of smoothed aggregation (GAMG, the
     nodes' rigid-body modes as near null space), the Schur complement through the fixed-stress
-    approximation A_pp -+ alpha^2 / K_dr int N_I (``DisplacementSplit.fixed_stress``, with the
-    whole matrix ``a`` held on every rank) or else PETSc's A_pp - A_pu diag(A_uu)^-1 A_up
+    approximation: A_pp with alpha^2 / K_dr int N_I added to its pressure diagonal, away from
+    zero in that diagonal's sign (``DisplacementSplit.fixed_stress``, with the whole matrix
+    ``a`` held on every rank), or else PETSc's A_pp - A_pu diag(A_uu)^-1 A_up
     ("selfp", poor for RK's overlapping supports), factorized by MUMPS. The second block, the
     pressures (and multipliers), is a scalar field: a third of the unknowns and a fraction of
     the fill of the whole system's LU. GMRES is preconditioned on the right, so that it stops
