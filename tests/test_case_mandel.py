@@ -43,6 +43,16 @@ def test_other_parameters_still_match_the_exact_solution():
     assert res.params["c"] != 1.0 and res.params["p0"] != 1.0
 
 
+def test_nitsche_and_the_field_split_give_the_collocated_profiles():
+    """--set bc_method=nitsche solver=fieldsplit: the same pressure errors as the defaults to 1e-4."""
+    pytest.importorskip("dolfinx_solver")
+    kw = dict(methods=("rkpm",), nx=41, ny=5, t_D=[0.01, 0.1], variants=["scni+fpp"], early_variants=[])
+    a = mandel.run(**kw).runs[0].errors
+    b = mandel.run(**kw, bc_method="nitsche", solver="fieldsplit").runs[0].errors
+    for key in ("l2_p_TD0.01", "l2_p_TD0.1"):
+        assert abs(a[key] - b[key]) <= 1e-4, (a, b)
+
+
 def test_cli_quick_writes_results_and_figures(tmp_path):
     pytest.importorskip("dolfinx_solver")
     assert mandel.main(["--quick", "--out", str(tmp_path)]) == 0
@@ -57,7 +67,8 @@ def test_cli_quick_writes_results_and_figures(tmp_path):
 
 
 @pytest.mark.parametrize("arg, word", [("bogus=1", "bogus"), ("nu=0.5", "Poisson"), ("k=-1", "mobility"),
-                                       ("variants=foo", "variant"), ("nx=2", "nx")])
+                                       ("variants=foo", "variant"), ("nx=2", "nx"), ("bc_method=weak", "bc_method"),
+                                       ("solver=fieldsplit", "nitsche"), ("solver=cg", "solver")])
 def test_bad_parameters_exit_2_with_one_line(arg, word, capsys):
     with pytest.raises(SystemExit) as e:
         mandel.main(["--quick", "--method", "rkpm", "--set", arg])

@@ -33,7 +33,8 @@ unstabilized and with the pressure projection) from ``fem_baselines.poroelastici
 
 Parameters and units (``--set NAME=VALUE``): E [Pa], nu [-], k [m^2/(Pa s)], alpha [-],
 S [1/Pa], Lx [m], Ly [m], F [N/m], nx, ny, dt_D [-], growth [-], t_D (list), variants (list),
-early_variants (list), fem (list), support_factor [-].
+early_variants (list), fem (list), support_factor [-], bc_method (transformation | nitsche),
+solver (mumps | fieldsplit: GMRES with a Schur split, for large grids, with bc_method=nitsche).
 
     python -m rkfx.cases.mandel [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
         [--checkpoint-every N] [--resume DIR] [--vtk]
@@ -56,6 +57,7 @@ from verification.mandel import Mandel
 from rkfx.conditions import Displacement, Pressure, split
 from rkfx.errors import InputError
 from rkfx.geometry.particles import structured
+from rkfx.assembly.boundary import BC_METHODS
 from rkfx.models.poroelasticity import VARIANTS, PoroMaterial, solve_biot
 from rkfx.solvers.integrate import time_grid
 from rkfx.cases import _cli, _paraview, _preflight
@@ -86,12 +88,15 @@ PARAMS = {
     "early_variants": Param(list(VARIANTS), "RKPM variants of the early-time study", fingerprint=False),
     "fem": Param(list(FEM_ELEMENTS), "FEM elements: taylor-hood, q1q1, q1q1-fpp", fingerprint=False),
     "support_factor": Param(1.5, "RK support radius / nodal spacing [-], > 1"),
+    "bc_method": Param("transformation", "RKPM displacement conditions: transformation (collocated) or nitsche"),
+    "solver": Param("mumps", "RKPM linear solver: mumps, or fieldsplit (GMRES with a Schur split; needs nitsche)"),
 }
 QUICK = {"nx": 41, "ny": 5, "t_D": [0.01, 0.1], "early_variants": ["ni", "scni+fpp"],
          "fem": ["taylor-hood", "q1q1-fpp"]}
 
 
-def _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F, support_factor=1.5):
+def _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F, support_factor=1.5,
+           bc_method="transformation", solver="mumps"):
     for name, v in (("nx", nx), ("ny", ny)):
         if v < 3:
             raise InputError(f"{name} = {v}: need at least 3 nodes per direction")
@@ -111,12 +116,18 @@ def _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F, 
     if F == 0:
         raise InputError("F = 0: the problem has no load")
     _preflight.support_factor_ok(support_factor)
+    if bc_method not in BC_METHODS:
+        raise InputError(f"unknown bc_method {bc_method!r}; choose one of {', '.join(BC_METHODS)}")
+    if solver not in ("mumps", "fieldsplit"):
+        raise InputError(f"unknown solver {solver!r}; choose mumps or fieldsplit")
+    if solver == "fieldsplit" and bc_method != "nitsche":
+        raise InputError("solver=fieldsplit needs bc_method=nitsche (multigrid on the displacements)")
 
 
 def check(*, E, nu, k, alpha, S, Lx, Ly, F, nx, ny, dt_D, growth, t_D, variants, early_variants, fem,
-          support_factor, **_) -> None:
+          support_factor, bc_method="transformation", solver="mumps", **_) -> None:
     """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
-    _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F, support_factor)
+    _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F, support_factor, bc_method, solver)
     PoroMaterial(E, nu, k, alpha, S)
     exact = Mandel(E, nu, k, Lx, Ly, F, alpha, S)
     first = dt_D * (Lx / (nx - 1)) ** 2 / exact.c  # the first step is the earliest time evaluated
@@ -140,11 +151,12 @@ def _conditions(exact):
             Pressure("right")]
 
 
-def _rkpm(p, material, bcs, times, outputs, variant, support_factor, desc, io, vtk=None, vtk_times=None):
+def _rkpm(p, material, bcs, times, outputs, variant, support_factor, desc, io, vtk=None, vtk_times=None,
+          bc_method="transformation", solver="mumps"):
     """One RKPM run; with ``vtk`` a folder, its fields at ``vtk_times`` [s] are written there."""
     kinds = split(bcs)
     sol = solve_biot(p, material, times, outputs, kinds[Displacement], kinds[Pressure], variant=variant,
-                     support_factor=support_factor, comm=_cli.comm(),
+                     support_factor=support_factor, comm=_cli.comm(), bc_method=bc_method, solver=solver,
                      progress=lambda it: _cli.progress(it, desc, len(times) - 1), **io)
     if vtk is not None:
         _paraview.write_biot(vtk, f"rkpm-{variant}", p, sol, material.elastic, _cli.comm(), vtk_times)
@@ -169,10 +181,11 @@ def _fem(xs, ys, material, bcs, times, outputs, element, samples, io, vtk=None, 
 def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, alpha=1.0, S=0.0, Lx=20.0,
         Ly=2.0, F=40.0, nx=101, ny=11, dt_D=0.01, growth=1.6, t_D=(0.01, 0.1, 0.5, 1.0),
         variants=("scni+fpp", "ni"), early_variants=VARIANTS, fem=FEM_ELEMENTS, support_factor=1.5,
-        checkpoint_every=0, work_dir=None, resume=None, vtk=None) -> Results:
+        bc_method="transformation", solver="mumps", checkpoint_every=0, work_dir=None, resume=None,
+        vtk=None) -> Results:
     """Both studies for every requested method; see the module docstring. ``vtk``: a folder for the
     ParaView files of the profiles study's runs at the times ``t_D`` (``--vtk``)."""
-    _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F, support_factor)
+    _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F, support_factor, bc_method, solver)
     material = PoroMaterial(E, nu, k, alpha, S)
     exact = Mandel(E, nu, k, Lx, Ly, F, alpha, S)
     c, p0 = exact.c, exact.p0
@@ -187,7 +200,8 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, 
     history_exact = exact.pressure(np.zeros(len(times) - 1), times[1:])
     params = dict(E=E, nu=nu, k=k, alpha=alpha, S=S, Lx=Lx, Ly=Ly, F=F, nx=nx, ny=ny, dt_D=dt_D, growth=growth,
                   t_D=list(t_D), variants=list(variants), early_variants=list(early_variants), fem=list(fem),
-                  support_factor=support_factor, c=c, p0=p0, h=h, steps=len(times) - 1)
+                  support_factor=support_factor, bc_method=bc_method, solver=solver, c=c, p0=p0, h=h,
+                  steps=len(times) - 1)
     results = Results(NAME, params)
     ck = _cli.Checkpoints(checkpoint_every, work_dir, resume)
     bcs = _conditions(exact)
@@ -197,7 +211,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, 
             solvers.append((f"rkpm-{v}", v in variants, v in early_variants,
                             lambda tt, out, key, shown=None, v=v: _rkpm(particles, material, bcs, tt, out, v,
                                                                         support_factor, f"rkpm {v}", ck.for_run(key),
-                                                                        shown, t_out)))
+                                                                        shown, t_out, bc_method, solver)))
     if "fem" in methods:
         for e in fem:
             def fem_solve(tt, out, key, shown=None, e=e):
