@@ -5,6 +5,7 @@ import pytest
 from conftest import l_shape, random_points, unit_square
 from rkfx.approximation.kernel import cubic_spline_values
 from rkfx.approximation.shape_functions import evaluate, rk_approximation
+from rkfx.errors import InputError
 
 
 def test_cubic_spline_kernel_values():
@@ -61,3 +62,21 @@ def test_component_matrices_do_not_share_index_arrays():
     m0.sort_indices()
     m0.max()
     assert np.array_equal(rows.matrix(1).toarray(), before)
+
+
+@pytest.mark.parametrize("order, factor", [(1, 2.0), (2, 3.0)])
+def test_implicit_gradients_reproduce_the_gradients_of_the_basis(order, factor):
+    """Eq. (6.28): the implicit gradient rows (6.29) give the exact gradient of every field the
+    basis holds; with the linear basis a quadratic's gradient is only approximate."""
+    p = unit_square(0.1)
+    rk = rk_approximation(p.x, p.spacing, factor, order)
+    pts = random_points(p, 300)
+    rows = evaluate(rk, pts, implicit=True)
+    x, y = rk.x[:, 0], rk.x[:, 1]
+    fields = [(1 + 0 * x, 0 * pts[:, 0], 0 * pts[:, 0]), (2 * x - 3 * y, 2 + 0 * pts[:, 0], -3 + 0 * pts[:, 0]),
+              (x * y, pts[:, 1], pts[:, 0])]
+    errors = [max(abs((rows @ f)[:, 1] - gx).max(), abs((rows @ f)[:, 2] - gy).max()) for f, gx, gy in fields]
+    assert max(errors[:2]) < 1e-11
+    assert (errors[2] < 1e-11) == (order == 2)
+    with pytest.raises(InputError, match="not both"):
+        evaluate(rk, pts, gradients=True, implicit=True)

@@ -169,10 +169,139 @@ def _count_cut(x, a, points, origin, cell, nx, ny, start, order, segments, tips,
                                     idx, dxs, dys, phis, dphis, 1.0, segments, tips, exponent, near)
 
 
+# What a row's entry vector holds: [N_I]; [N_I, N_I,x, N_I,y] (direct); [N_I, N^∇_Ix, N^∇_Iy]
+# (implicit, eq. 6.29); or SECOND: the implicit ones followed by their derivatives
+# [N^∇_Ix,x, N^∇_Ix,y, N^∇_Iy,x, N^∇_Iy,y] (linear basis only).
+VALUES, DIRECT, IMPLICIT, SECOND = 0, 1, 2, 3
+
+
+@numba.njit(inline="always")
+def linear_row(n, idx, dxs, dys, phis, dphis, inv, mode, base, indices, out):
+    """One point's linear-basis RK entries from its gathered neighbours, written at ``base``.
+
+    The 3 x 3 moment matrix is inverted by cofactors. Returns det(A) / prod(diag(A)) (0 when A
+    is singular, and nothing is written then).
+    """
+    m00 = m01 = m02 = m11 = m12 = m22 = 0.0
+    for k in range(n):
+        f = phis[k]
+        m00 += f
+        m01 += f * dxs[k]
+        m02 += f * dys[k]
+        m11 += f * dxs[k] * dxs[k]
+        m12 += f * dxs[k] * dys[k]
+        m22 += f * dys[k] * dys[k]
+    c00 = m11 * m22 - m12 * m12
+    c01 = m02 * m12 - m01 * m22
+    c02 = m01 * m12 - m02 * m11
+    det = m00 * c00 + m01 * c01 + m02 * c02
+    hd = m00 * m11 * m22
+    ratio = det / hd if hd > 0.0 else 0.0
+    if not ratio > 1e-14:
+        return 0.0
+    b0 = c00 / det
+    b1 = c01 / det
+    b2 = c02 / det
+    if mode == VALUES:
+        for k in range(n):
+            indices[base + k] = idx[k]
+            out[base + k, 0] = (b0 + b1 * dxs[k] + b2 * dys[k]) * phis[k]
+        return ratio
+    c11 = m00 * m22 - m02 * m02
+    c12 = m01 * m02 - m00 * m12
+    c22 = m00 * m11 - m01 * m01
+    if mode == IMPLICIT:
+        # eq. (6.29): A^-1 H_bar_i with H_bar = [0, -1, 0], [0, 0, -1] in the scaled basis,
+        # so the gradient rows reproduce grad(x) = I and grad(1) = 0 (6.28).
+        gx0, gx1, gx2 = -inv * c01 / det, -inv * c11 / det, -inv * c12 / det
+        gy0, gy1, gy2 = -inv * c02 / det, -inv * c12 / det, -inv * c22 / det
+        for k in range(n):
+            indices[base + k] = idx[k]
+            out[base + k, 0] = (b0 + b1 * dxs[k] + b2 * dys[k]) * phis[k]
+            out[base + k, 1] = (gx0 + gx1 * dxs[k] + gx2 * dys[k]) * phis[k]
+            out[base + k, 2] = (gy0 + gy1 * dxs[k] + gy2 * dys[k]) * phis[k]
+        return ratio
+    # Gradients of a coefficient vector c (b for N, g_i for N^∇_i): c_,j = -A^-1 A_,j c, with
+    # A^-1 = cofactors / det (symmetric).
+    dm = np.empty((2, 6))
+    _moment_gradient(n, dxs, dys, phis, dphis, inv, dm)
+    db = np.empty((2, 3))
+    if mode == DIRECT:
+        _coefficient_gradient(dm, b0, b1, b2, c00, c01, c02, c11, c12, c22, det, db)
+        for k in range(n):
+            bh = b0 + b1 * dxs[k] + b2 * dys[k]
+            indices[base + k] = idx[k]
+            out[base + k, 0] = bh * phis[k]
+            out[base + k, 1] = ((db[0, 0] + db[0, 1] * dxs[k] + db[0, 2] * dys[k]) * phis[k]
+                                + b1 * inv * phis[k] + bh * dphis[k, 0])
+            out[base + k, 2] = ((db[1, 0] + db[1, 1] * dxs[k] + db[1, 2] * dys[k]) * phis[k]
+                                + b2 * inv * phis[k] + bh * dphis[k, 1])
+        return ratio
+    # SECOND: the implicit gradients (6.29) and their direct derivatives at the point, which
+    # approximate N_I,ij and vanish on linear fields (the derivative of (6.28)).
+    gx0, gx1, gx2 = -inv * c01 / det, -inv * c11 / det, -inv * c12 / det
+    gy0, gy1, gy2 = -inv * c02 / det, -inv * c12 / det, -inv * c22 / det
+    dgx = np.empty((2, 3))
+    dgy = np.empty((2, 3))
+    _coefficient_gradient(dm, gx0, gx1, gx2, c00, c01, c02, c11, c12, c22, det, dgx)
+    _coefficient_gradient(dm, gy0, gy1, gy2, c00, c01, c02, c11, c12, c22, det, dgy)
+    for k in range(n):
+        u, v, f = dxs[k], dys[k], phis[k]
+        hx = gx0 + gx1 * u + gx2 * v
+        hy = gy0 + gy1 * u + gy2 * v
+        indices[base + k] = idx[k]
+        out[base + k, 0] = (b0 + b1 * u + b2 * v) * f
+        out[base + k, 1] = hx * f
+        out[base + k, 2] = hy * f
+        out[base + k, 3] = (dgx[0, 0] + dgx[0, 1] * u + dgx[0, 2] * v) * f + gx1 * inv * f + hx * dphis[k, 0]
+        out[base + k, 4] = (dgx[1, 0] + dgx[1, 1] * u + dgx[1, 2] * v) * f + gx2 * inv * f + hx * dphis[k, 1]
+        out[base + k, 5] = (dgy[0, 0] + dgy[0, 1] * u + dgy[0, 2] * v) * f + gy1 * inv * f + hy * dphis[k, 0]
+        out[base + k, 6] = (dgy[1, 0] + dgy[1, 1] * u + dgy[1, 2] * v) * f + gy2 * inv * f + hy * dphis[k, 1]
+    return ratio
+
+
+@numba.njit(inline="always")
+def _moment_gradient(n, dxs, dys, phis, dphis, inv, dm):
+    """The six distinct entries of dA/dx_i of the scaled linear moment matrix, as ``dm[i]``."""
+    for i in range(2):
+        d00 = d01 = d02 = d11 = d12 = d22 = 0.0
+        for k in range(n):
+            f = phis[k]
+            g = dphis[k, i]
+            u = dxs[k]
+            v = dys[k]
+            hu = inv if i == 0 else 0.0
+            hv = inv if i == 1 else 0.0
+            d00 += g
+            d01 += hu * f + u * g
+            d02 += hv * f + v * g
+            d11 += 2.0 * u * hu * f + u * u * g
+            d12 += (hu * v + u * hv) * f + u * v * g
+            d22 += 2.0 * v * hv * f + v * v * g
+        dm[i, 0] = d00
+        dm[i, 1] = d01
+        dm[i, 2] = d02
+        dm[i, 3] = d11
+        dm[i, 4] = d12
+        dm[i, 5] = d22
+
+
+@numba.njit(inline="always")
+def _coefficient_gradient(dm, q0, q1, q2, c00, c01, c02, c11, c12, c22, det, dq):
+    """dq[i] = -A^-1 (dA/dx_i) q for a coefficient vector q."""
+    for i in range(2):
+        r0 = dm[i, 0] * q0 + dm[i, 1] * q1 + dm[i, 2] * q2
+        r1 = dm[i, 1] * q0 + dm[i, 3] * q1 + dm[i, 4] * q2
+        r2 = dm[i, 2] * q0 + dm[i, 4] * q1 + dm[i, 5] * q2
+        dq[i, 0] = -(c00 * r0 + c01 * r1 + c02 * r2) / det
+        dq[i, 1] = -(c01 * r0 + c11 * r1 + c12 * r2) / det
+        dq[i, 2] = -(c02 * r0 + c12 * r1 + c22 * r2) / det
+
+
 @numba.njit(parallel=True, cache=True)
-def _rows_linear(x, a, points, scale, origin, cell, nx, ny, start, order, indptr, kmax, with_grad,
+def _rows_linear(x, a, points, scale, origin, cell, nx, ny, start, order, indptr, kmax, mode,
                  segments, tips, exponent, indices, out, ratio):
-    """Linear-basis RK rows in closed form (3 x 3 moment matrix by cofactors)."""
+    """Linear-basis RK rows in closed form (``linear_row``) at points found through the cell grid."""
     m = points.shape[0]
     for c in numba.prange((m + CHUNK - 1) // CHUNK):
         idx, dxs, dys, phis, dphis, near = _scratch(kmax, segments.shape[0])
@@ -180,67 +309,7 @@ def _rows_linear(x, a, points, scale, origin, cell, nx, ny, start, order, indptr
             inv = 1.0 / scale[p]
             n = _gather(points[p, 0], points[p, 1], x, a, origin, cell, nx, ny, start, order,
                         idx, dxs, dys, phis, dphis, inv, segments, tips, exponent, near)
-            m00 = m01 = m02 = m11 = m12 = m22 = 0.0
-            for k in range(n):
-                f = phis[k]
-                m00 += f
-                m01 += f * dxs[k]
-                m02 += f * dys[k]
-                m11 += f * dxs[k] * dxs[k]
-                m12 += f * dxs[k] * dys[k]
-                m22 += f * dys[k] * dys[k]
-            c00 = m11 * m22 - m12 * m12
-            c01 = m02 * m12 - m01 * m22
-            c02 = m01 * m12 - m02 * m11
-            det = m00 * c00 + m01 * c01 + m02 * c02
-            hd = m00 * m11 * m22
-            ratio[p] = det / hd if hd > 0.0 else 0.0
-            if not ratio[p] > 1e-14:
-                ratio[p] = 0.0
-                continue
-            b0 = c00 / det
-            b1 = c01 / det
-            b2 = c02 / det
-            base = indptr[p]
-            if not with_grad:
-                for k in range(n):
-                    indices[base + k] = idx[k]
-                    out[base + k, 0] = (b0 + b1 * dxs[k] + b2 * dys[k]) * phis[k]
-                continue
-            # b_,i = -A^-1 A_,i b, with A^-1 = cofactors / det (symmetric).
-            c11 = m00 * m22 - m02 * m02
-            c12 = m01 * m02 - m00 * m12
-            c22 = m00 * m11 - m01 * m01
-            db = np.zeros((2, 3))
-            for i in range(2):
-                d00 = d01 = d02 = d11 = d12 = d22 = 0.0
-                for k in range(n):
-                    f = phis[k]
-                    g = dphis[k, i]
-                    u = dxs[k]
-                    v = dys[k]
-                    hu = inv if i == 0 else 0.0
-                    hv = inv if i == 1 else 0.0
-                    d00 += g
-                    d01 += hu * f + u * g
-                    d02 += hv * f + v * g
-                    d11 += 2.0 * u * hu * f + u * u * g
-                    d12 += (hu * v + u * hv) * f + u * v * g
-                    d22 += 2.0 * v * hv * f + v * v * g
-                r0 = d00 * b0 + d01 * b1 + d02 * b2
-                r1 = d01 * b0 + d11 * b1 + d12 * b2
-                r2 = d02 * b0 + d12 * b1 + d22 * b2
-                db[i, 0] = -(c00 * r0 + c01 * r1 + c02 * r2) / det
-                db[i, 1] = -(c01 * r0 + c11 * r1 + c12 * r2) / det
-                db[i, 2] = -(c02 * r0 + c12 * r1 + c22 * r2) / det
-            for k in range(n):
-                bh = b0 + b1 * dxs[k] + b2 * dys[k]
-                indices[base + k] = idx[k]
-                out[base + k, 0] = bh * phis[k]
-                out[base + k, 1] = ((db[0, 0] + db[0, 1] * dxs[k] + db[0, 2] * dys[k]) * phis[k]
-                                      + b1 * inv * phis[k] + bh * dphis[k, 0])
-                out[base + k, 2] = ((db[1, 0] + db[1, 1] * dxs[k] + db[1, 2] * dys[k]) * phis[k]
-                                      + b2 * inv * phis[k] + bh * dphis[k, 1])
+            ratio[p] = linear_row(n, idx, dxs, dys, phis, dphis, inv, mode, indptr[p], indices, out)
 
 
 @numba.njit(inline="always")
@@ -257,10 +326,11 @@ def _basis(u, v, order, h):
 
 
 @numba.njit(parallel=True, cache=True)
-def _rows_generic(x, a, points, scale, origin, cell, nx, ny, start, order, indptr, kmax, with_grad,
+def _rows_generic(x, a, points, scale, origin, cell, nx, ny, start, order, indptr, kmax, mode,
                   basis_order, segments, tips, exponent, indices, out, ratio):
     """RK rows for any basis order: moment matrix (3.24) solved by Cholesky."""
     nb = 3 if basis_order == 1 else 6
+    with_grad = mode == DIRECT
     m = points.shape[0]
     for c in numba.prange((m + CHUNK - 1) // CHUNK):
         idx, dxs, dys, phis, dphis, near = _scratch(kmax, segments.shape[0])
@@ -304,6 +374,11 @@ def _rows_generic(x, a, points, scale, origin, cell, nx, ny, start, order, indpt
                         for j in range(nb):
                             t -= dmom[d, i, j] * rhs[j, 0]
                         rhs[i, d + 1] = t
+            elif mode == IMPLICIT:  # eq. (6.29): A^-1 H_bar_i, H_bar_i = -e_(i+1) in the scaled basis
+                rhs[:, 1:] = 0.0
+                rhs[1, 1] = -inv
+                rhs[2, 2] = -inv
+            if mode != VALUES:
                 fac[:] = mom
                 _cholesky_solve(fac, rhs[:, 1:], nb)
             base = indptr[p]
@@ -322,23 +397,34 @@ def _rows_generic(x, a, points, scale, origin, cell, nx, ny, start, order, indpt
                             t += rhs[i, d + 1] * h[0, i]
                             hd += rhs[i, 0] * h[d + 1, i]
                         out[base + k, d + 1] = t * phis[k] + hd * inv * phis[k] + bh * dphis[k, d]
+                elif mode == IMPLICIT:
+                    for d in range(2):
+                        t = 0.0
+                        for i in range(nb):
+                            t += rhs[i, d + 1] * h[0, i]
+                        out[base + k, d + 1] = t * phis[k]
 
 
-def evaluate(rk: RKApproximation, points: np.ndarray, gradients: bool = False) -> SparseRows:
-    """Shape functions N_I (and their direct gradients) at points.
+def evaluate(rk: RKApproximation, points: np.ndarray, gradients: bool = False, implicit: bool = False) -> SparseRows:
+    """Shape functions N_I (and their direct or implicit gradients) at points.
 
     Returns rows over nodes whose entry vectors are ``[N_I]``, or ``[N_I, N_I,x, N_I,y]`` with
-    ``gradients=True``.
+    ``gradients=True``, or ``[N_I, N^∇_Ix, N^∇_Iy]`` with ``implicit=True``.
 
     Args:
         rk: The approximation.
         points: Evaluation points, shape ``(num_points, 2)`` [m].
         gradients: Also compute direct gradients (3.25 differentiated).
+        implicit: Also compute implicit gradients (6.29): the rows that reproduce the gradients
+            of linear (or, with ``order=2``, quadratic) fields, at almost no cost beyond N_I.
 
     Raises:
         SingularMomentMatrix: At a point covered by too few, or collinear, supports; the
             message names the point and its nearest node and suggests a larger support.
     """
+    if gradients and implicit:
+        raise InputError("evaluate: ask for direct (gradients=True) or implicit gradients, not both")
+    mode = DIRECT if gradients else IMPLICIT if implicit else VALUES
     points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
     g = cell_grid(rk.x, rk.support, points)
     grid = (g.origin, g.cell, *g.shape, g.start, g.order)
@@ -352,15 +438,15 @@ def evaluate(rk: RKApproximation, points: np.ndarray, gradients: bool = False) -
     np.cumsum(counts, out=indptr[1:])
     nnz = int(indptr[-1])
     indices = np.empty(nnz, np.int32)
-    out = np.empty((nnz, 3 if gradients else 1))
+    out = np.empty((nnz, 1 if mode == VALUES else 3))
     ratio = np.zeros(len(points))
     # Basis scale: any length of the order of the supports; N_I does not depend on it.
     scale = np.full(len(points), float(np.median(rk.support)))
     if rk.order == 1:
-        _rows_linear(rk.x, rk.support, points, scale, *grid, indptr, kmax, gradients, *cut,
+        _rows_linear(rk.x, rk.support, points, scale, *grid, indptr, kmax, mode, *cut,
                      indices, out, ratio)
     else:
-        _rows_generic(rk.x, rk.support, points, scale, *grid, indptr, kmax, gradients, rk.order, *cut,
+        _rows_generic(rk.x, rk.support, points, scale, *grid, indptr, kmax, mode, rk.order, *cut,
                       indices, out, ratio)
     bad = np.flatnonzero(~(ratio >= RCOND_MIN))
     if bad.size:

@@ -1,0 +1,47 @@
+"""Matrices of a nodal integration (``rkfx.integration.nodal_stabilized``), with test and trial
+gradients apart (the VC correction changes only the test side, eqs. 6.78-6.79).
+
+    K = sum_L V_L B^c_L^T D B_L + sum_L (m_Lx B_L,x^T D B_L,x + m_Ly B_L,y^T D B_L,y)
+    A = sum_L V_L (grad^c N)_L^T k (grad N)_L + the same expansion terms with k
+
+Degrees of freedom of vector fields are interleaved per node, strains in Voigt order, as in
+``rkfx.assembly.operators``.
+"""
+import numpy as np
+import scipy.sparse as sp
+
+from rkfx.approximation.sparse_rows import SparseRows
+from rkfx.assembly.operators import block_diagonal, strain_matrix
+from rkfx.integration.nodal_stabilized import NodalIntegration
+
+
+def _gradient_matrix(rows: SparseRows) -> sp.csr_matrix:
+    """(grad N) with rows (d/dx, d/dy) per point, shape ``(2 m, n)``."""
+    return sp.vstack([rows.matrix(0), rows.matrix(1)]).tocsr()[
+        np.ravel(np.stack([np.arange(rows.num_rows), rows.num_rows + np.arange(rows.num_rows)], axis=1))]
+
+
+def _weighted(blocks: np.ndarray, w: np.ndarray) -> sp.csr_matrix:
+    return block_diagonal(w[:, None, None] * np.broadcast_to(blocks, (len(w), *blocks.shape[-2:])))
+
+
+def _form(rule: NodalIntegration, matrix_of, metric: np.ndarray) -> sp.csr_matrix:
+    """``T^T W T'`` of the test and trial rows plus the expansion terms, with ``matrix_of`` the
+    point operator of a row set (strains or gradients) and ``metric`` its coefficient."""
+    form = matrix_of(rule.test).T @ _weighted(metric, rule.weights) @ matrix_of(rule.trial)
+    if rule.moments is not None:
+        for j, rows in enumerate((rule.trial_x, rule.trial_y)):
+            b = matrix_of(rows)
+            form = form + b.T @ _weighted(metric, rule.moments[:, j]) @ b
+    return form.tocsr()
+
+
+def stiffness(rule: NodalIntegration, d: np.ndarray) -> sp.csr_matrix:
+    """Elastic stiffness of the rule, shape ``(2 n, 2 n)``; ``d``: ``(3, 3)`` or ``(n, 3, 3)`` [Pa]."""
+    return _form(rule, strain_matrix, np.asarray(d, dtype=float))
+
+
+def laplacian(rule: NodalIntegration, k=1.0) -> sp.csr_matrix:
+    """Diffusion matrix of the rule, shape ``(n, n)``; ``k``: a scalar or ``(2, 2)`` tensor [m^2/(Pa s)]."""
+    kt = np.asarray(k, dtype=float) * np.eye(2) if np.ndim(k) == 0 else np.asarray(k, dtype=float)
+    return _form(rule, _gradient_matrix, kt)
