@@ -45,3 +45,26 @@ def laplacian(rule: NodalIntegration, k=1.0) -> sp.csr_matrix:
     """Diffusion matrix of the rule, shape ``(n, n)``; ``k``: a scalar or ``(2, 2)`` tensor [m^2/(Pa s)]."""
     kt = np.asarray(k, dtype=float) * np.eye(2) if np.ndim(k) == 0 else np.asarray(k, dtype=float)
     return _form(rule, _gradient_matrix, kt)
+
+
+def _divergence_matrix(rows: SparseRows) -> sp.csr_matrix:
+    """div u at each point, shape ``(m, 2 n)``: m^T B with m = (1, 1, 0)."""
+    b = strain_matrix(rows)
+    return (b[0::3] + b[1::3]).tocsr()
+
+
+def coupling(rule: NodalIntegration, alpha: float) -> sp.csr_matrix:
+    """``sum_L V_L alpha (B^c_L)^T m N_L``: the pressure's force on u, shape ``(2 n, n)`` [m^2]
+    (the internal force is K u - coupling p, eq. 6.78)."""
+    return (alpha * _divergence_matrix(rule.test).T @ sp.diags(rule.weights) @ rule.values.matrix()).tocsr()
+
+
+def divergence(rule: NodalIntegration, alpha: float) -> sp.csr_matrix:
+    """``sum_L V_L alpha N_L^T m^T B_L``: the storage rows' alpha div u' term, shape ``(n, 2 n)`` [m^2]
+    (eq. 6.79; the test functions are values, so no correction enters)."""
+    return (alpha * rule.values.matrix().T @ sp.diags(rule.weights) @ _divergence_matrix(rule.trial)).tocsr()
+
+
+def lumped(rule: NodalIntegration, c: float = 1.0) -> np.ndarray:
+    """Row-sum lumped mass ``sum_L V_L c N_I(x_L)`` per node, shape ``(n,)``."""
+    return c * (rule.values.matrix().T @ rule.weights)

@@ -1,0 +1,220 @@
+"""Explicit u-p dynamics: Newmark with beta1 = 1/2, beta2 = 0 for u, the trapezoid with theta = 0
+for p, lumped masses (eqs. 6.37-6.43).
+
+The model (``ExplicitUPModel``) has a displacement field of time order 2 and a pressure field of
+time order 1 (``rkfx.solvers.fields``), lumped masses M_u (inertia) and M_p (storage 1/Q), and
+gives the two halves of its internal force apart, because the fluid half needs the new velocity:
+
+    M_u a_{n+1}  = f_ext,u(t_{n+1}) - f_u(u_{n+1}, p_{n+1})                  (6.42)
+    M_p p'_{n+1} = f_ext,p(t_{n+1}) - f_p(u'_{n+1}, p_{n+1})                 (6.43)
+
+One step n -> n+1:
+
+    u_{n+1}  = u_n + dt u'_n + dt^2/2 a_n                    (6.39, beta2 = 0)
+    p_{n+1}  = p_n + dt p'_n                                 (6.41, theta = 0)
+    a_{n+1}  from (6.42);  u'_{n+1} = u'_n + dt/2 (a_n + a_{n+1})   (6.38, beta1 = 1/2)
+    p'_{n+1} from (6.43)
+
+Essential conditions (``rkfx.solvers.central_difference.Constraint`` rows over the whole vector,
+e.g. collocation rows of u or p at boundary nodes) are imposed by M-orthogonal projection of the
+new values and rates, as in ``CentralDifference``: G x_{n+1} = g(t_{n+1}), G x'_{n+1} = g'(t_{n+1}).
+
+Stability needs dt below both the wave limit 2 / omega_max of M_u^-1 K_uu and the diffusion
+limit 2 / lambda_max of M_p^-1 H (forward Euler on the pressure). ``stable_steps`` estimates
+both by power iteration; ``ExplicitUPRun.limits`` reports them and which one governs.
+"""
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+from rkfx.errors import InputError
+from rkfx.solvers.central_difference import Constraint, _Projection
+from rkfx.solvers.fields import FieldLayout
+
+
+@runtime_checkable
+class ExplicitUPModel(Protocol):
+    """What ``ExplicitUP`` needs of a model.
+
+    Attributes:
+        layout: Fields ``u`` (time order 2) then ``p`` (time order 1).
+        essential: Essential conditions, rows over the whole vector.
+    """
+
+    layout: FieldLayout
+    essential: Sequence[Constraint]
+
+    def lumped_mass(self) -> np.ndarray:
+        """M_u on the u unknowns [kg] and M_p on the p unknowns [m^3/Pa], shape ``(size,)``, positive."""
+
+    def solid_force(self, u: np.ndarray, p: np.ndarray) -> np.ndarray:
+        """f_u(u, p), the u block of the internal force [N], shape ``(size_u,)``."""
+
+    def fluid_flux(self, v: np.ndarray, p: np.ndarray) -> np.ndarray:
+        """f_p(u', p), the p block [m^3/s], shape ``(size_p,)``."""
+
+    def external_force(self, t: float) -> np.ndarray | None:
+        """f_ext(t) over the whole vector, or ``None``."""
+
+
+@dataclass
+class ExplicitUPRun:
+    """A finished run: final state and the recorded samples.
+
+    Attributes:
+        x: Final [u, p], shape ``(size,)``.
+        rate: Final [u', p'], shape ``(size,)``.
+        times: Recorded times [s], shape ``(num_samples,)``.
+        samples: What the recorder returned at each recorded time, stacked.
+        steps: Steps taken.
+        limits: ``{"wave": dt, "diffusion": dt}`` stable-step estimates [s] when computed.
+    """
+
+    x: np.ndarray
+    rate: np.ndarray
+    times: np.ndarray
+    samples: np.ndarray
+    steps: int
+    limits: dict = field(default_factory=dict)
+
+
+def _power_iteration(apply: Callable[[np.ndarray], np.ndarray], n: int, iterations: int = 60,
+                     seed: int = 0) -> float:
+    """Largest eigenvalue of a symmetric-positive operator (in its mass metric) by power iteration."""
+    w = np.random.default_rng(seed).standard_normal(n)
+    lam = 0.0
+    for _ in range(iterations):
+        z = apply(w)
+        norm = np.linalg.norm(z)
+        if norm == 0.0:
+            return 0.0
+        lam = float(w @ z / (w @ w))
+        w = z / norm
+    return lam
+
+
+def stable_steps(model: ExplicitUPModel, safety: float = 1.0) -> dict[str, float]:
+    """Stable-step estimates [s]: ``wave`` = 2 / omega_max of the undrained skeleton and
+    ``diffusion`` = 2 / lambda_max of M_p^-1 H, each times ``safety``; ``governs`` names the smaller."""
+    lay = model.layout
+    su, sp_ = lay.block("u"), lay.block("p")
+    m = model.lumped_mass()
+    mu, mp = m[su], m[sp_]
+    nu, npr = mu.size, mp.size
+    zero_p, zero_u = np.zeros(npr), np.zeros(nu)
+    # Undrained (the fast wave): no flow, so M_p p' = -C_pu u' gives p = -M_p^-1 f_p(u, 0) and the
+    # skeleton sees K + C_up M_p^-1 C_pu.
+    omega2 = _power_iteration(lambda w: model.solid_force(w, -model.fluid_flux(w, zero_p) / mp) / mu, nu)
+    # The flux's response to p alone: f_p(0, p) = H p (+ the stabilization, which is part of it).
+    lam = _power_iteration(lambda w: model.fluid_flux(zero_u, w) / mp, npr)
+    wave = safety * 2.0 / np.sqrt(omega2) if omega2 > 0 else np.inf
+    diffusion = safety * 2.0 / lam if lam > 0 else np.inf
+    return {"wave": wave, "diffusion": diffusion, "governs": "wave" if wave <= diffusion else "diffusion"}
+
+
+def _by_field(constraints: Sequence[Constraint], su: slice, sp_: slice) -> tuple[list, list]:
+    """The conditions on u and those on p, each with its rows restricted to its own block (the
+    two masses differ by many orders of magnitude, so each field is projected in its own metric)."""
+    on_u, on_p = [], []
+    for c in constraints:
+        g = c.G.tocsc()
+        in_u, in_p = g[:, su].nnz, g[:, sp_].nnz
+        if in_u and in_p:
+            raise InputError("an essential condition couples u and p unknowns; give each field its own conditions")
+        block, out = (su, on_u) if in_u else (sp_, on_p)
+        out.append(Constraint(g[:, block].tocsr(), c.displacement, c.velocity))
+    return on_u, on_p
+
+
+def _project(proj, w: np.ndarray, target) -> None:
+    if proj.G is not None:
+        proj.project(w, target)
+
+
+@dataclass
+class ExplicitUP:
+    """The stepper. ``dt`` [s] is the step; ``check_stability`` refuses a dt above the estimates.
+
+    Attributes:
+        dt: Step size [s].
+        check_stability: Estimate the stable steps first and refuse a larger ``dt``.
+    """
+
+    dt: float
+    check_stability: bool = True
+
+    def __post_init__(self):
+        if not (np.isfinite(self.dt) and self.dt > 0):
+            raise InputError(f"dt = {self.dt!r}: the time step must be a positive number of seconds")
+
+    def run(self, model: ExplicitUPModel, num_steps: int, *, record: Callable[[np.ndarray, np.ndarray, float], np.ndarray]
+            | None = None, record_every: int = 1, x0: np.ndarray | None = None,
+            progress: Callable[[int], None] | None = None) -> ExplicitUPRun:
+        """Advance ``num_steps`` steps from rest (or ``x0``), recording ``record(x, rate, t)``
+        at t = 0 and every ``record_every`` steps."""
+        lay = model.layout
+        if lay.field("u").order != 2 or lay.field("p").order != 1:
+            raise InputError("ExplicitUP needs a displacement field 'u' of time order 2 and a pressure 'p' of order 1")
+        su, sp_ = lay.block("u"), lay.block("p")
+        n = lay.size
+        mass = np.asarray(model.lumped_mass(), float)
+        if mass.shape != (n,) or not np.all(mass > 0):
+            raise InputError("lumped_mass() must give a positive mass for each of the model's unknowns")
+        limits = {}
+        if self.check_stability:
+            limits = stable_steps(model)
+            bound = min(limits["wave"], limits["diffusion"])
+            if self.dt > bound:
+                raise InputError(f"dt = {self.dt:.4g} s exceeds the stable step {bound:.4g} s (the {limits['governs']} "
+                                 f"limit; wave {limits['wave']:.4g} s, diffusion {limits['diffusion']:.4g} s): "
+                                 "take a smaller dt")
+        proj_u, proj_p = (_Projection(part, mass[block]) for part, block in
+                          zip(_by_field(model.essential, su, sp_), (su, sp_)))
+        dt = self.dt
+        x = np.zeros(n) if x0 is None else np.array(x0, float)
+        rate = np.zeros(n)
+        acc = np.zeros(n)  # only the u block is used
+
+        def f_ext(t):
+            f = model.external_force(t)
+            return np.zeros(n) if f is None else np.asarray(f, float)
+
+        def rates(x, rate, acc_old, t, first=False):
+            """a_{n+1} and the new rates from the new x (6.42, 6.38, 6.43)."""
+            f = f_ext(t)
+            a = np.zeros(n)
+            a[su] = (f[su] - model.solid_force(x[su], x[sp_])) / mass[su]
+            new = rate.copy()
+            new[su] = rate[su] if first else rate[su] + 0.5 * dt * (acc_old[su] + a[su])
+            _project(proj_u, new[su], proj_u.velocity_target(t, dt) if proj_u.G is not None else None)
+            new[sp_] = (f[sp_] - model.fluid_flux(new[su], x[sp_])) / mass[sp_]
+            _project(proj_p, new[sp_], proj_p.velocity_target(t, dt) if proj_p.G is not None else None)
+            return a, new
+
+        acc, rate = rates(x, rate, acc, 0.0, first=True)
+        times, samples = [], []
+        if record is not None:
+            times.append(0.0)
+            samples.append(np.asarray(record(x, rate, 0.0)))
+        for step in range(1, num_steps + 1):
+            t = step * dt
+            x_new = x.copy()
+            x_new[su] += dt * rate[su] + 0.5 * dt * dt * acc[su]
+            x_new[sp_] += dt * rate[sp_]
+            for proj, block in ((proj_u, su), (proj_p, sp_)):
+                if proj.G is not None:
+                    part = x_new[block]  # a view: projected in place
+                    proj.project(part, proj.displacement_target(part, t))
+            if not np.all(np.isfinite(x_new)):
+                raise InputError(f"step {step} (t = {t:.4g} s): the solution is no longer finite; "
+                                 "the step is unstable, take a smaller dt")
+            acc, rate = rates(x_new, rate, acc, t)
+            x = x_new
+            if record is not None and step % record_every == 0:
+                times.append(t)
+                samples.append(np.asarray(record(x, rate, t)))
+            if progress is not None:
+                progress(step)
+        return ExplicitUPRun(x, rate, np.array(times), np.array(samples), num_steps, limits)

@@ -1,0 +1,64 @@
+"""The explicit u-p stepper (beta1 = 1/2, beta2 = 0, theta = 0; eqs. 6.37-6.43) on a two-unknown
+u-p system with a known solution: it converges to it at first order (forward Euler on p), the
+stable-step estimate holds, and a larger step is refused in one line."""
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from rkfx.errors import InputError
+from rkfx.solvers.explicit_up import ExplicitUP, stable_steps
+from rkfx.solvers.fields import layout
+
+M, K, C, MP, H, F = 2.0, 50.0, 3.0, 0.5, 4.0, 1.0
+
+
+class TwoUnknowns:
+    """m u'' + k u - c p = f,  m_p p' + c u' + h p = 0 (a one-node consolidating oscillator)."""
+
+    layout = layout(("u", 1, 2), ("p", 1, 1), nodes=1)
+    essential = ()
+
+    def lumped_mass(self):
+        return np.array([M, MP])
+
+    def solid_force(self, u, p):
+        return K * u - C * p
+
+    def fluid_flux(self, v, p):
+        return C * v + H * p
+
+    def external_force(self, t):
+        return np.array([F, 0.0])
+
+
+def _reference(t_end):
+    def rhs(t, y):
+        u, v, p = y
+        return [v, (F - K * u + C * p) / M, -(C * v + H * p) / MP]
+    sol = solve_ivp(rhs, (0.0, t_end), [0.0, 0.0, 0.0], rtol=1e-12, atol=1e-14, dense_output=True)
+    return sol.sol
+
+
+def test_converges_at_first_order_to_the_exact_history():
+    t_end = 2.0
+    ref = _reference(t_end)
+    errors = []
+    for steps in (400, 800, 1600):
+        run = ExplicitUP(t_end / steps).run(TwoUnknowns(), steps, record=lambda x, r, t: x.copy())
+        exact = ref(run.times)[[0, 2]].T
+        errors.append(np.abs(run.samples - exact).max() / np.abs(exact).max())
+    rates = np.log2(np.array(errors[:-1]) / errors[1:])
+    assert np.all(rates > 0.9), (errors, rates)
+    assert errors[-1] < 5e-3
+
+
+def test_the_stable_step_estimate_is_the_coupled_one():
+    limits = stable_steps(TwoUnknowns())
+    # undrained skeleton stiffness k + c^2 / m_p, and the diffusion eigenvalue h / m_p
+    assert limits["wave"] == pytest.approx(2.0 / np.sqrt((K + C * C / MP) / M), rel=1e-6)
+    assert limits["diffusion"] == pytest.approx(2.0 * MP / H, rel=1e-6)
+    assert limits["governs"] == "diffusion"  # 0.25 s against 0.34 s
+    with pytest.raises(InputError, match="the diffusion limit"):
+        ExplicitUP(1.01 * limits["diffusion"]).run(TwoUnknowns(), 10)
+    with pytest.raises(InputError, match="time step"):
+        ExplicitUP(-1.0)
