@@ -15,6 +15,9 @@ M, K, C, MP, H, F = 2.0, 50.0, 3.0, 0.5, 4.0, 1.0
 class TwoUnknowns:
     """m u'' + k u - c p = f,  m_p p' + c u' + h p = 0 (a one-node consolidating oscillator)."""
 
+    def __init__(self, k=K, c=C, h=H):
+        self.k, self.c, self.h = k, c, h
+
     layout = layout(("u", 1, 2), ("p", 1, 1), nodes=1)
     essential = ()
 
@@ -22,10 +25,10 @@ class TwoUnknowns:
         return np.array([M, MP])
 
     def solid_force(self, u, p):
-        return K * u - C * p
+        return self.k * u - self.c * p
 
     def fluid_flux(self, v, p):
-        return C * v + H * p
+        return self.c * v + self.h * p
 
     def external_force(self, t):
         return np.array([F, 0.0])
@@ -58,7 +61,17 @@ def test_the_stable_step_estimate_is_the_coupled_one():
     assert limits["wave"] == pytest.approx(2.0 / np.sqrt((K + C * C / MP) / M), rel=1e-6)
     assert limits["diffusion"] == pytest.approx(2.0 * MP / H, rel=1e-6)
     assert limits["governs"] == "diffusion"  # 0.25 s against 0.34 s
-    with pytest.raises(InputError, match="the diffusion limit"):
-        ExplicitUP(1.01 * limits["diffusion"]).run(TwoUnknowns(), 10)
+    with pytest.raises(InputError, match="the diffusion governs"):
+        ExplicitUP(1.01 * limits["coupled"]).run(TwoUnknowns(), 10)
     with pytest.raises(InputError, match="time step"):
         ExplicitUP(-1.0)
+
+
+@pytest.mark.parametrize("k, c, h", [(1.0, 3.0, 0.0), (1.0, 3.0, 1.0), (1.0, 3.0, 3.0), (1.0, 10.0, 10.0),
+                                     (10.0, 1.0, 5.0), (1.0, 10.0, 100.0)])
+def test_the_allowed_step_is_stable_undrained_and_where_the_two_limits_meet(k, c, h):
+    model = TwoUnknowns(k, c, h)
+    dt = 0.99 * stable_steps(model)["coupled"]
+    run = ExplicitUP(dt).run(model, 5000, record=lambda x, r, t: x.copy())
+    static = F / k  # drained equilibrium u = f / k, p = 0 (undrained, h = 0: oscillates about f / (k + c^2 / m_p))
+    assert np.abs(run.samples).max() < 3.0 * max(static, c * static / MP)
