@@ -33,7 +33,7 @@ limit 2 / lambda_max of M_p^-1 H (forward Euler on the pressure), and somewhat l
 two are close. ``stable_steps`` estimates both by power iteration and the step allowed;
 ``ExplicitUPRun.limits`` reports them and which one governs.
 """
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Protocol, runtime_checkable
 
@@ -110,7 +110,9 @@ def stable_steps(model: ExplicitUPModel, safety: float = 1.0) -> dict[str, float
     ``diffusion`` = 2 / lambda_max of M_p^-1 H, each times ``safety``; ``governs`` names the
     smaller. ``coupled`` = 1 / (1/wave + 1/diffusion) is the step the stepper allows: where both
     limits are close the coupled scheme's limit falls below the smaller (to 0.62 of it on the
-    one-node systems of ``tests/test_explicit_up.py``, where ``coupled`` is 0.50-0.91 of it)."""
+    one-node systems of ``tests/test_explicit_up.py``, where ``coupled`` is 0.50-0.91 of it).
+    Power iteration approaches the largest eigenvalues from below, so the estimates can be a few
+    percent long: run at a fraction of ``coupled`` (e.g. 0.9, as ``safety`` or on dt)."""
     lay = model.layout
     su, sp_ = lay.block("u"), lay.block("p")
     m = model.lumped_mass()
