@@ -23,6 +23,11 @@ dt from 0.3 to 0.99 of 2 / omega). With the step's increment the undrained limit
 central-difference scheme of the undrained skeleton, stable up to 2 / omega_max, and the
 diffusion is forward Euler, stable up to 2 / lambda_max; together, see ``stable_steps``.
 
+``rkfx.solvers.newmark.Newmark(beta=0, gamma=1/2, theta=0)`` takes the literal reading (the
+storage rows see u'_{n+1}), and on the same one-node undrained system it grows at 0.1, 0.3 and
+0.6 of 2 / omega (measured). This stepper stands apart until that coupling moves into Newmark's
+explicit path, where it belongs (one stepper family).
+
 Essential conditions (``rkfx.solvers.central_difference.Constraint`` rows over the whole vector,
 e.g. collocation rows of u or p at boundary nodes) are imposed by M-orthogonal projection of the
 new values and rates, as in ``CentralDifference``, each field in its own mass metric:
