@@ -25,8 +25,9 @@ diffusion is forward Euler, stable up to 2 / lambda_max; together, see ``stable_
 
 ``rkfx.solvers.newmark.Newmark(beta=0, gamma=1/2, theta=0)`` takes the literal reading (the
 storage rows see u'_{n+1}), and on the same one-node undrained system it grows at 0.1, 0.3 and
-0.6 of 2 / omega (measured). This stepper stands apart until that coupling moves into Newmark's
-explicit path, where it belongs (one stepper family).
+0.6 of 2 / omega (measured). This stepper stands apart until Newmark's explicit path can take
+it, which needs more than another rate: a staggered predictor that updates p after u within the
+step (Newmark's predictors both use the old rates, so p would lag u by a step).
 
 Essential conditions (``rkfx.solvers.central_difference.Constraint`` rows over the whole vector,
 e.g. collocation rows of u or p at boundary nodes) are imposed by M-orthogonal projection of the
