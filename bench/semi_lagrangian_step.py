@@ -67,6 +67,8 @@ def main(argv=None):
     ap.add_argument("--nodes", nargs="+", type=float, default=[1e4, 1e5, 1e6])
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args(argv)
+    from rkfx.memory import reuse_freed_memory  # noqa: PLC0415
+    reuse_freed_memory()  # as a run would: each step's arrays reuse the last step's freed memory
     step_times(400, 1)  # compile / load the cached kernels
     results = [step_times(int(n), args.repeat) for n in sorted(args.nodes)]
     print(f"{'particles':>10} {'step':>6} {'rows searched':>14} {'search [s]':>11} {'rows [s]':>9} "
