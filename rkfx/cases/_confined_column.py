@@ -1,0 +1,51 @@
+"""The RKPM model of the laterally confined u-p column of §6.4.1, for the wave-column study.
+
+A column 0 <= y <= L of three nodes across (rollers on both sides), the base fixed in y and
+impermeable, the top drained (p = 0) and loaded by a compressive traction q from t = 0. The
+nodes are a uniform grid, a = 2 h, the cells their median-dual areas as squares, and the rule
+any of ``rkfx.integration.nodal_stabilized.RULES``.
+"""
+import numpy as np
+
+from rkfx.approximation.semi_lagrangian import evaluate_moving, moving_rk
+from rkfx.geometry.nodal_domains import nodal_domains
+from rkfx.geometry.particles import structured
+from rkfx.integration.nodal_stabilized import boundary_rule, nodal_cells, nodal_integration
+from rkfx.models.explicit_poroelasticity import Constituents, ExplicitPoroDynamics, collocation_rows
+from rkfx.solvers.central_difference import Constraint
+
+#: The data of §6.4.1 (Soares 2014).
+SOARES = Constituents(E=254423076.9, nu=0.298, rho_s=2700.0, rho_f=1000.0, porosity=0.48, k=3.55e-9,
+                      K_s=1.1e10, K_f=3.3e9)
+
+
+def confined_column(ny: int, rule: str = "nsni", medium: Constituents = SOARES, height: float = 10.0,
+                    load: float = 3000.0) -> tuple[ExplicitPoroDynamics, int, int]:
+    """The model, a top node and a base node (indices) of a column of ``ny`` nodes along y.
+
+    Args:
+        ny: Nodes along the height.
+        rule: The nodal integration rule.
+        medium: The constituents.
+        height: L [m].
+        load: q [Pa], compressive, on the top from t = 0.
+    """
+    h = height / (ny - 1)
+    p = structured(2 * h, height, 3, ny)
+    cells = nodal_cells(p.x, nodal_domains(p).area)
+    rk = moving_rk(p.x, 2.0 * h, 0.5 * h, reach=cells.reach)
+    r = nodal_integration(rk, cells, boundary_rule(p.x, p.boundary_edges), rule)
+    x, n = p.x, p.num_nodes
+    size = 3 * n
+    tol = 1e-9 * height
+    bottom = np.flatnonzero(x[:, 1] < tol)
+    top = np.flatnonzero(x[:, 1] > height - tol)
+    sides = np.flatnonzero((x[:, 0] < tol) | (x[:, 0] > 2 * h - tol))
+    essential = [Constraint(collocation_rows(rk, bottom, 1, n, 0, size)),      # u_y = 0 at the base
+                 Constraint(collocation_rows(rk, sides, 0, n, 0, size)),       # rollers
+                 Constraint(collocation_rows(rk, top, None, n, 2 * n, size))]  # drained top
+    top_edges = p.boundary_edges[np.all(x[p.boundary_edges][:, :, 1] > height - tol, axis=1)]
+    tb = boundary_rule(x, top_edges)
+    f = np.zeros(size)
+    f[1:2 * n:2] = evaluate_moving(rk, tb.points, tb.owner).matrix().T @ (-load * np.abs(tb.normal_length[:, 1]))
+    return ExplicitPoroDynamics(r, medium, essential, load=lambda t: f), int(top[0]), int(bottom[0])
