@@ -75,3 +75,17 @@ def test_the_allowed_step_is_stable_undrained_and_where_the_two_limits_meet(k, c
     run = ExplicitUP(dt).run(model, 5000, record=lambda x, r, t: x.copy())
     static = F / k  # drained equilibrium u = f / k, p = 0 (undrained, h = 0: oscillates about f / (k + c^2 / m_p))
     assert np.abs(run.samples).max() < 3.0 * max(static, c * static / MP)
+
+
+def test_a_resumed_run_ends_where_an_uninterrupted_one_does(tmp_path):
+    record = lambda x, r, t: x.copy()  # noqa: E731
+    whole = ExplicitUP(0.005).run(TwoUnknowns(), 300, record=record, record_every=7)
+    ExplicitUP(0.005).run(TwoUnknowns(), 140, record=record, record_every=7, checkpoint_every=70,
+                          checkpoint_dir=tmp_path)
+    resumed = ExplicitUP(0.005).run(TwoUnknowns(), 300, record=record, record_every=7, checkpoint_every=70,
+                                    checkpoint_dir=tmp_path, resume=tmp_path)
+    assert resumed.resumed_from == 140
+    assert np.array_equal(resumed.x, whole.x) and np.array_equal(resumed.rate, whole.rate)
+    assert np.array_equal(resumed.times, whole.times) and np.array_equal(resumed.samples, whole.samples)
+    with pytest.raises(InputError, match="dt = "):
+        ExplicitUP(0.004).run(TwoUnknowns(), 300, resume=tmp_path)

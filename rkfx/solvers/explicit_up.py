@@ -47,6 +47,7 @@ import numpy as np
 
 from rkfx.errors import InputError
 from rkfx.solvers.central_difference import Constraint, _Projection
+from rkfx.solvers.checkpoint import has_checkpoint, load_arrays, save_arrays
 from rkfx.solvers.fields import FieldLayout
 
 
@@ -86,6 +87,7 @@ class ExplicitUPRun:
         samples: What the recorder returned at each recorded time, stacked.
         steps: Steps taken.
         limits: ``{"wave": dt, "diffusion": dt}`` stable-step estimates [s] when computed.
+        resumed_from: Step of the checkpoint the run continued from, or ``None``.
     """
 
     x: np.ndarray
@@ -94,6 +96,7 @@ class ExplicitUPRun:
     samples: np.ndarray
     steps: int
     limits: dict = field(default_factory=dict)
+    resumed_from: int | None = None
 
 
 def _power_iteration(apply: Callable[[np.ndarray], np.ndarray], n: int, iterations: int = 60,
@@ -173,9 +176,18 @@ class ExplicitUP:
 
     def run(self, model: ExplicitUPModel, num_steps: int, *, record: Callable[[np.ndarray, np.ndarray, float], np.ndarray]
             | None = None, record_every: int = 1, x0: np.ndarray | None = None,
-            progress: Callable[[int], None] | None = None) -> ExplicitUPRun:
+            progress: Callable[[int], None] | None = None, checkpoint_every: int = 0,
+            checkpoint_dir=None, resume=None, comm=None) -> ExplicitUPRun:
         """Advance ``num_steps`` steps from rest (or ``x0``), recording ``record(x, rate, t)``
-        at t = 0 and every ``record_every`` steps."""
+        at t = 0 and every ``record_every`` steps.
+
+        ``checkpoint_every`` steps (and at the last) the state and the samples so far go to
+        ``checkpoint_dir`` (written by rank 0 of ``comm``); ``resume``, a folder holding such a
+        checkpoint of the same model and dt, continues from it to the same result as an
+        uninterrupted run (the acceleration is a function of the state, so x and the rates
+        are the whole state)."""
+        if checkpoint_every and checkpoint_dir is None:
+            raise InputError("checkpoint_every needs checkpoint_dir")
         lay = model.layout
         if lay.field("u").order != 2 or lay.field("p").order != 1:
             raise InputError("ExplicitUP needs a displacement field 'u' of time order 2 and a pressure 'p' of order 1")
@@ -214,12 +226,30 @@ class ExplicitUP:
                 part = w[block]  # a view: projected in place
                 proj.project(part, target(part))
 
-        acc = acceleration(x, 0.0)
         times, samples = [], []
-        if record is not None:
+        first, resumed_from = 1, None
+        if resume is not None and has_checkpoint(resume):
+            ck = load_arrays(resume)
+            if ck["x"].shape != (n,) or float(ck["dt"]) != dt:
+                raise InputError(f"the checkpoint in {str(resume)!r} has {ck['x'].size} unknowns and dt = "
+                                 f"{float(ck['dt']):.6g} s, this run {n} and {dt:.6g} s: resume the same run, or "
+                                 "delete the folder to start afresh")
+            resumed_from = int(ck["step"])
+            if resumed_from > num_steps:
+                raise InputError(f"the checkpoint is at step {resumed_from}, beyond num_steps = {num_steps}")
+            x, rate, first = ck["x"].copy(), ck["rate"].copy(), resumed_from + 1
+            times, samples = list(ck["times"]), list(ck["samples"])
+        elif record is not None:
             times.append(0.0)
             samples.append(np.asarray(record(x, rate, 0.0)))
-        for step in range(1, num_steps + 1):
+
+        def save(step):
+            save_arrays(checkpoint_dir, {"x": x, "rate": rate, "step": np.int64(step), "dt": np.float64(dt),
+                                         "times": np.asarray(times, float), "samples": np.asarray(samples)},
+                        comm=comm)
+
+        acc = acceleration(x, (first - 1) * dt)
+        for step in range(first, num_steps + 1):
             t = step * dt
             x_new = x.copy()
             x_new[su] += dt * rate[su] + 0.5 * dt * dt * acc[su]
@@ -242,4 +272,6 @@ class ExplicitUP:
                 samples.append(np.asarray(record(x, rate, t)))
             if progress is not None:
                 progress(step)
-        return ExplicitUPRun(x, rate, np.array(times), np.array(samples), num_steps, limits)
+            if checkpoint_every and (step % checkpoint_every == 0 or step == num_steps):
+                save(step)
+        return ExplicitUPRun(x, rate, np.array(times), np.array(samples), num_steps, limits, resumed_from)
