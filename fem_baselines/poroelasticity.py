@@ -84,7 +84,7 @@ from rkfx.models.poroelasticity import PoroMaterial, fpp_parameter
 from rkfx.solvers.fields import Field, FieldLayout
 from rkfx.solvers.integrate import integrate
 from rkfx.solvers.model import Constraints, PerStepSize
-from rkfx.solvers.newmark import StepState, backward_euler
+from rkfx.solvers.newmark import Newmark, StepState, backward_euler
 
 __all__ = [
     "BiotResult",
@@ -282,7 +282,8 @@ class FemBiotModel:
 
     The unknowns, the same on every rank, are ``[u, p]`` in dolfinx's global dof numbering: u
     interleaved per node of the displacement space V, then p per node of Q; both of time order
-    1 (u is quasi-static; its rate enters the storage equation). As in
+    1 (u is quasi-static; its rate enters the storage equation), or u of order 2 with the
+    consistent mass rho int v . u when ``density`` > 0 (u-p dynamics, eqs. 6.42-6.44). As in
     ``rkfx.models.poroelasticity.BiotModel``, C x' + r(x, t) = 0 with
 
         r = [K_uu u - K_up p - F(t), K_H p - Q(t)],   C(dt) = [[0, 0], [K_up^T, K_S + S(dt)]],
@@ -302,8 +303,11 @@ class FemBiotModel:
     """
 
     def __init__(self, mesh: dolfinx.mesh.Mesh, E: float, nu: float, k: float, alpha: float, S: float,
-                 element: str, conditions: Sequence[Condition], fpp_form: str = "rate", t0: float = 0.0):
-        self.comm, self.material = mesh.comm, (E, nu, k, alpha, S)
+                 element: str, conditions: Sequence[Condition], fpp_form: str = "rate", t0: float = 0.0,
+                 density: float = 0.0):
+        if not (np.isfinite(density) and density >= 0):
+            raise ValueError(f"density = {density!r} must be >= 0 (0: quasi-static)")
+        self.comm, self.material, self.density = mesh.comm, (E, nu, k, alpha, S), float(density)
         mesh.topology.create_connectivity(mesh.topology.dim - 1, mesh.topology.dim)
         self._degree = 2 if element == "taylor-hood" else 1  # of u
         self.V = dolfinx.fem.functionspace(mesh, ("Lagrange", self._degree, (2,)))
@@ -315,7 +319,8 @@ class FemBiotModel:
         self.u_index = (2 * v_nodes[:, None] + np.arange(2)).ravel()
         self.p_index = self._n_u + q_map.local_to_global(np.arange(q_map.size_local + q_map.num_ghosts,
                                                                    dtype=np.int32))
-        self.layout = FieldLayout((Field("u", 2, 1, v_map.size_global), Field("p", 1, 1, q_map.size_global)))
+        self.layout = FieldLayout((Field("u", 2, 2 if density > 0 else 1, v_map.size_global),
+                                   Field("p", 1, 1, q_map.size_global)))
         self.linear = True
         self.fpp = element == "q1q1-fpp"
         self.seed = self.fpp and fpp_form == "seed"
@@ -348,6 +353,10 @@ class FemBiotModel:
         ks = _global_matrix(dolfinx.fem.form(constant(S) * p * q * dx), comm) if S > 0 else sp.csr_matrix((n_p, n_p))
         self._K = sp.bmat([[kuu, -kup], [None, kh]], format="csr")
         self._C = sp.bmat([[sp.csr_matrix((n_u, n_u)), None], [kup.T, ks]], format="csr")
+        self._M = None
+        if self.density > 0:  # consistent mass of the mixture on u (eq. 6.44)
+            muu = _global_matrix(dolfinx.fem.form(constant(self.density) * ufl.inner(u, v) * dx), comm)
+            self._M = sp.bmat([[muu, None], [None, sp.csr_matrix((n_p, n_p))]], format="csr")
         if self.fpp:
             DG0 = dolfinx.fem.functionspace(mesh, ("DG", 0))
             self._eps_f = dolfinx.fem.Function(DG0, name="eps_f")
@@ -482,8 +491,9 @@ class FemBiotModel:
         self._t_trial = t
         return self.tangent(x, t) @ x - self.loads(t)
 
-    def mass(self) -> None:
-        return None
+    def mass(self) -> sp.csr_matrix | None:
+        """rho int v . u over [u, p] (``density`` > 0), else ``None`` (quasi-static)."""
+        return self._M
 
     def capacity(self, dt: float) -> sp.csr_matrix:
         if not self.fpp or self.seed:
@@ -560,6 +570,8 @@ def solve_biot(
     resume: str | Path | None = None,
     vtk=None,
     progress: Callable | None = None,
+    density: float = 0.0,
+    stepper: Newmark | None = None,
 ) -> BiotResult:
     """Solve plane-strain Biot consolidation with backward Euler and a monolithic u-p solve.
 
@@ -604,6 +616,11 @@ def solve_biot(
         vtk: A ``fem_baselines.paraview.FemSeries`` on ``mesh`` that receives u and p at the
             output times (a resumed run writes the times after its checkpoint), or ``None``.
         progress: Optional wrapper of the step iterator (a progress bar).
+        density: Mixture density rho [kg/m^3]; > 0 adds the inertia of the skeleton (u of
+            time order 2, consistent mass), 0 (default) is quasi-static consolidation.
+        stepper: The time stepper; default backward Euler when quasi-static, the trapezoid
+            (Newmark beta = 1/4, gamma = 1/2, theta = 1/2) with inertia. The initial
+            acceleration follows from the loads at times[0].
 
     Returns:
         The sampled history and final fields; see :class:`BiotResult`.
@@ -633,7 +650,10 @@ def solve_biot(
     if not (E > 0 and -1.0 < nu < 0.5 and k >= 0 and S >= 0):
         raise ValueError(f"need E > 0, -1 < nu < 0.5, k >= 0, S >= 0; got E={E}, nu={nu}, k={k}, S={S}")
 
-    model = FemBiotModel(mesh, E, nu, k, alpha, S, element, conditions, fpp_form, t0=float(times[0]))
+    model = FemBiotModel(mesh, E, nu, k, alpha, S, element, conditions, fpp_form, t0=float(times[0]),
+                         density=density)
+    if stepper is None:
+        stepper = backward_euler() if density == 0 else Newmark(beta=0.25, gamma=0.5, theta=0.5)
     uh = dolfinx.fem.Function(model.V, name="u")
     ph = dolfinx.fem.Function(model.Q, name="p")
     if initial_u is not None:
@@ -641,15 +661,14 @@ def solve_biot(
     if initial_p is not None:
         ph.interpolate(lambda x: _initial(initial_p, x, ()))
     n = model.layout.size
-    start = StepState(0, float(times[0]), model.vector(uh, ph), np.zeros(n), np.zeros(n),
-                      np.zeros(model.num_constraints))
+    start = stepper.start(model, model.vector(uh, ph), t0=float(times[0]), comm=comm)
     kept = _Samples(model, _Sampler(mesh, sample_points), out_index, uh, ph, vtk)
     kept.record(start)
     t_setup, sampled = time.perf_counter() - t_start, kept.seconds
 
     solves = Factorizations(comm, "mumps", keep=2, mumps_icntl=_MUMPS_ICNTL, reuse_analysis=True)
     try:
-        run = integrate(backward_euler(), model, times, start=start, recorder=kept, solves=solves, max_cuts=0,
+        run = integrate(stepper, model, times, start=start, recorder=kept, solves=solves, max_cuts=0,
                         checkpoint_every=checkpoint_every, checkpoint_dir=checkpoint_dir, resume=resume,
                         progress=progress)
     finally:
