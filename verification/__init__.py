@@ -10,4 +10,6 @@
                    (Wei 2018, eqs. 4.7-4.9): force and crack opening against the tip displacement
     sneddon        opening of a pressurized straight crack in an unbounded plane (Sneddon 1946,
                    Wei 2018 eq. 5.37)
+    wave_column    step-loaded saturated u-p column with inertia (Wei 2018 §6.4.1): Laplace domain,
+                   Fourier-series inversion; the undrained rod in closed form
 """
