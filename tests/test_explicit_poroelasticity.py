@@ -14,7 +14,7 @@ L, Q_LOAD = 10.0, 3000.0
 
 
 def test_the_base_sees_twice_the_undrained_pressure_after_the_fast_wave():
-    model, i_top, i_bot = confined_column(121, "nsni", height=L, load=Q_LOAD)
+    model, i_top, i_bot, _ = confined_column(121, "nsni", height=L, load=Q_LOAD)
     n = model.layout.field("p").nodes
     limits = stable_steps(model)
     assert limits["governs"] == "wave"

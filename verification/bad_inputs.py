@@ -220,6 +220,10 @@ ROWS: list[Row] = [
                               ("tracking tolerance above 1", "tol=2")]),
     Row("no FEM baseline yet", "injection", ("--method", "fem")),
     Row("too big for memory", "injection", ("--set", "h=1e-5")),
+    *_case_rows("wave_column", [("unknown nodal rule", "rules=nsni,fem"), ("porosity 1", "porosity=1"),
+                                ("grains softer than the skeleton", "K_s=1e8"), ("Courant number above 1", "courant=1.5"),
+                                ("too few nodes along the height", "ny=3"), ("exclusion wider than the history", "exclude=1")]),
+    Row("too big for memory", "wave_column", ("--set", "ny=99999999")),
     # --- geometry files ---
     Row("broken .geo file", "", code="from_geo('broken.geo')", setup=_file("broken.geo", BROKEN_GEO)),
     Row(".geo file with an undefined point", "", code="from_geo('undefined.geo')",

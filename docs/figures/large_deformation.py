@@ -80,7 +80,7 @@ def _energy_ratios(ax):
 
 def _column(ax):
     for rule, style in (("nsni", "C2-"), ("dni", "C0-")):
-        model, i_top, i_bot = confined_column(241, rule)
+        model, i_top, i_bot, _ = confined_column(241, rule)
         n = model.layout.field("p").nodes
         dt = 0.9 * stable_steps(model)["coupled"]
         steps = int(np.ceil(0.03 / dt))

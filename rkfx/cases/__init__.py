@@ -23,4 +23,6 @@ the machine cannot hold it), see ``rkfx.cases._preflight``.
                       discrete FEM slit on the same fixed square.
     injection         fluid injection into a notched saturated plate (seed 5.3.2): hydraulic
                       fracture by the coupled damage particle method.
+    wave_column       waves in a saturated u-p column (seed 6.4.1): explicit RKPM on NSNI and
+                      DNI, Taylor-Hood with the trapezoid, the exact Laplace-domain solution.
 """

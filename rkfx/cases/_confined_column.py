@@ -5,7 +5,10 @@ impermeable, the top drained (p = 0) and loaded by a compressive traction q from
 nodes are a uniform grid, a = 2 h, the cells their median-dual areas as squares, and the rule
 any of ``rkfx.integration.nodal_stabilized.RULES``.
 """
+from typing import NamedTuple
+
 import numpy as np
+import scipy.sparse as sp
 
 from rkfx.approximation.semi_lagrangian import evaluate_moving, moving_rk
 from rkfx.geometry.nodal_domains import nodal_domains
@@ -19,9 +22,26 @@ SOARES = Constituents(E=254423076.9, nu=0.298, rho_s=2700.0, rho_f=1000.0, poros
                       K_s=1.1e10, K_f=3.3e9)
 
 
+class ConfinedColumn(NamedTuple):
+    """The column's model and where it is observed.
+
+    Attributes:
+        model: The explicit u-p model.
+        top: A node on the top (index).
+        base: A node on the base (index).
+        probe: Rows over the whole vector giving [u_y^h, p^h] on the axis at the top and at
+            the base: ``probe @ x`` = [u_y(W/2, L), p(W/2, 0)].
+    """
+
+    model: ExplicitPoroDynamics
+    top: int
+    base: int
+    probe: sp.csr_matrix
+
+
 def confined_column(ny: int, rule: str = "nsni", medium: Constituents = SOARES, height: float = 10.0,
-                    load: float = 3000.0) -> tuple[ExplicitPoroDynamics, int, int]:
-    """The model, a top node and a base node (indices) of a column of ``ny`` nodes along y.
+                    load: float = 3000.0) -> ConfinedColumn:
+    """The model of a column of ``ny`` nodes along y, two of its nodes and its probe.
 
     Args:
         ny: Nodes along the height.
@@ -48,4 +68,8 @@ def confined_column(ny: int, rule: str = "nsni", medium: Constituents = SOARES, 
     tb = boundary_rule(x, top_edges)
     f = np.zeros(size)
     f[1:2 * n:2] = evaluate_moving(rk, tb.points, tb.owner).matrix().T @ (-load * np.abs(tb.normal_length[:, 1]))
-    return ExplicitPoroDynamics(r, medium, essential, load=lambda t: f), int(top[0]), int(bottom[0])
+    axis = np.abs(x[:, 0] - h) < tol
+    probe = sp.vstack([collocation_rows(rk, np.flatnonzero(axis & (x[:, 1] > height - tol)), 1, n, 0, size),
+                       collocation_rows(rk, np.flatnonzero(axis & (x[:, 1] < tol)), None, n, 2 * n, size)]).tocsr()
+    return ConfinedColumn(ExplicitPoroDynamics(r, medium, essential, load=lambda t: f), int(top[0]),
+                          int(bottom[0]), probe)
