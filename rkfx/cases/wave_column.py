@@ -271,7 +271,9 @@ def plot(results: Results, out: Path) -> list[Path]:
             ax.set_xlabel("t [ms]")
         for ax in axes.ravel():
             ax.grid(alpha=0.3)
-        axes[0, 0].legend(fontsize=7, loc="lower right")
+        low, high = axes[0, 0].get_ylim()
+        axes[0, 0].set_ylim(low, high + 0.35 * (high - low))  # room for the legend above the curves
+        axes[0, 0].legend(fontsize=7, loc="upper right", ncol=2)
         axes[1, 0].legend(fontsize=7, loc="center right")
         axes[0, 1].set_title("grey bands: +-exclude around the fronts (left out of the L2 errors)", fontsize=8)
         what = f"{prm['ny']} nodes along the height" if study == "rules" else "NSNI under refinement"
