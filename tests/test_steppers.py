@@ -68,6 +68,43 @@ class Diffusion(Stateless):
                            np.array([np.cos(t)]))
 
 
+class NonlinearStorage(Stateless):
+    """(1 + x^2) x' + x = 0 through ``rate_force``: ln x + x^2 / 2 = ln x0 + x0^2 / 2 - t."""
+
+    def __init__(self):
+        self.layout = single("x", 1, 1, 1)
+        self.linear = False
+
+    def residual(self, x, t):
+        return x.copy()
+
+    def tangent(self, x, t):
+        return sp.identity(1, format="csr")
+
+    def mass(self):
+        return None
+
+    def capacity(self, dt):
+        return None
+
+    def rate_force(self, x, v):
+        self._at = (x.copy(), v.copy())
+        return (1.0 + x**2) * v
+
+    def rate_tangents(self):
+        x, v = self._at
+        return sp.diags(2.0 * x * v), sp.diags(1.0 + x**2)
+
+    def constraints(self, t):
+        return no_constraints(1)
+
+    @staticmethod
+    def exact(x0, t):
+        from scipy.optimize import brentq
+        c = np.log(x0) + 0.5 * x0**2 - t
+        return brentq(lambda x: np.log(x) + 0.5 * x**2 - c, 1e-12, x0)
+
+
 class Final:
     def __init__(self):
         self.x = []
@@ -131,6 +168,24 @@ def test_duffing_trapezoid_second_order():
     ref = run(st, model, 1.0, 5120, [1.0]).x[0]
     errs = [abs(run(st, model, 1.0, n, [1.0]).x[0] - ref) for n in (40, 80, 160, 320)]
     assert np.all(rates(errs) > 1.85), errs
+
+
+@pytest.mark.parametrize("theta, order", [(1.0, 1.0), (0.5, 2.0)])
+def test_state_dependent_capacity_orders(theta, order):
+    model = NonlinearStorage()
+    x0 = 1.5
+    v0 = [-x0 / (1.0 + x0**2)]
+    exact = NonlinearStorage.exact(x0, 1.0)
+    errs = [abs(run(nm.theta_method(theta, rtol=1e-13), model, 1.0, n, [x0], v0).x[0] - exact)
+            for n in (10, 20, 40, 80)]
+    r = rates(errs)
+    assert np.all(np.abs(r - order) < 0.15), (errs, r)
+
+
+def test_state_dependent_capacity_needs_implicit_rates():
+    model = NonlinearStorage()
+    with pytest.raises(InputError, match="rate_force"):
+        run(nm.theta_method(0.0), model, 0.1, 2, [1.0], [-0.5])
 
 
 def test_linear_model_reuses_one_factorization():

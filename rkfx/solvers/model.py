@@ -13,6 +13,10 @@ plastic strain, saturation) evaluates it as a *trial* from the committed state i
 ``residual`` call; the steppers ``commit()`` once a step is accepted, so a failed Newton
 iteration or a cut step never touches committed state, and checkpoints save ``state()``.
 
+A capacity that depends on the state (unsaturated storage) is the optional term c(x, v)
+of ``rate_force(x, v)``, with ``rate_tangents()`` = (dc/dx, dc/dv) at its last point, added
+to C x' (``rkfx.solvers.newmark``).
+
 The steppers only call the methods below; ``rkfx.solvers.newmark`` and
 ``rkfx.solvers.quasi_static`` document which they need.
 """

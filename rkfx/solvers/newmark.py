@@ -14,6 +14,12 @@ and solves M a_{n+1} + C v_{n+1} + r(x_{n+1}, t_{n+1}) = G^T mu with G x_{n+1} =
 by Newton on the corrector w = x_{n+1} - x~. The Jacobian is M/(beta dt^2) + C gamma/(beta dt)
 + K on second-order columns and C/(theta dt) + K on first-order ones.
 
+A model whose capacity depends on its state (unsaturated storage 1/Q(p), the coupling
+alpha S_w(p) div u') adds the term c(x, v) through ``rate_force(x, v)``, with its derivatives
+``rate_tangents()`` = (dc/dx, dc/dv) at the last point; they enter the Jacobian as
+dc/dx diag(dx) + dc/dv diag(dv). Such a model is not ``linear``, and its rate fields must be
+implicit.
+
 With beta = 0 or theta = 0 a field is explicit (eqs. 6.37-6.41, beta_2 = 0 and theta = 0):
 x_{n+1} = x~ is known, and the unknown w is a_{n+1} (resp. v_{n+1}), so the step is one
 linear solve with M + gamma dt C (resp. C), lumped or not. Essential conditions on an
@@ -231,6 +237,9 @@ class _Plan:
                              "constrain each field on its own rows")
         self.any_explicit = bool(self.on_explicit.any())
         self.share = share = getattr(model, "share", None)
+        if explicit.any() and hasattr(model, "rate_force"):
+            raise InputError("a model with a state-dependent capacity (rate_force) needs implicit rate fields; "
+                             "take theta > 0 and beta > 0")
         if share is not None and share.total(self.any_explicit):
             raise InputError("explicit fields (beta = 0 or theta = 0) of a model distributed over MPI ranks are not "
                              "supported; run it on one rank, or take an implicit stepper")
@@ -271,6 +280,7 @@ class _NewmarkSystem:
         self.G, self.Gw = plan.G, plan.scaled_rows(co)
         self.W = equation_weights(model, co)
         self.cw = _constraint_weights(self.G, self.Gw, self.W)
+        self.rated = hasattr(model, "rate_force")
         self.linear = plan.linear
         on_explicit = plan.on_explicit
         if on_explicit.any():
@@ -298,6 +308,8 @@ class _NewmarkSystem:
         x, v, a = self.state(z)
         terms = [self.model.residual(x, self.t1)]
         terms += [mat @ rate for mat, rate in ((self.M, a), (self.C, v)) if mat is not None]
+        if self.rated:
+            terms.append(self.model.rate_force(x, v))
         mu = z[self.n:]
         if self.share is not None:
             # The whole model's terms at every local entry (one exchange for all of them).
@@ -319,8 +331,9 @@ class _NewmarkSystem:
         co = self.co
         x, _, _ = self.state(z)
         j = None
+        d_x, d_v = self.model.rate_tangents() if self.rated else (None, None)
         for mat, scale in ((self.model.tangent(x, self.t1) if (co.dx != 0).any() else None, co.dx),
-                           (self.M, co.da), (self.C, co.dv)):
+                           (self.M, co.da), (self.C, co.dv), (d_x, co.dx), (d_v, co.dv)):
             if mat is None or not scale.any():
                 continue
             term = _scale_columns(sp.csr_matrix(mat), scale)
