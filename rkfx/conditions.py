@@ -47,6 +47,19 @@ Boundary = str | Callable[[np.ndarray], np.ndarray] | Region
 Value = float | Sequence[float] | np.ndarray | Callable[..., Any]
 
 
+def _check_value(condition) -> None:
+    """A constant value must be finite numbers (a function of x and t is checked where evaluated)."""
+    if callable(condition.value):
+        return
+    try:
+        v = np.asarray(condition.value, dtype=float)
+    except (TypeError, ValueError):
+        v = None
+    if v is None or not np.all(np.isfinite(v)):
+        raise InputError(f"{type(condition).__name__} on {condition.boundary!r}: value {condition.value!r} must be "
+                         "finite numbers or a function of (x, t); list the prescribed components in components=")
+
+
 @dataclass(frozen=True)
 class _Vectorial:
     """A condition on some components of a vector field."""
@@ -56,6 +69,7 @@ class _Vectorial:
     components: tuple[int, ...] = (0, 1)
 
     def __post_init__(self):
+        _check_value(self)
         comps = tuple(self.components)
         if not comps or len(set(comps)) != len(comps) or any(int(k) != k or k < 0 or k > 2 for k in comps):
             raise InputError(f"{type(self).__name__} on {self.boundary!r}: components {self.components!r} must be "
@@ -69,6 +83,9 @@ class _Scalar:
     boundary: Boundary
     value: Value = 0.0
     components: tuple[int, ...] = (0,)
+
+    def __post_init__(self):
+        _check_value(self)
 
 
 class Displacement(_Vectorial):

@@ -30,6 +30,10 @@ def test_vectors_and_natural_conditions():
 def test_bad_conditions_name_the_culprit():
     with pytest.raises(InputError, match="components"):
         Displacement("top", 0.0, (0, 0))
+    with pytest.raises(InputError, match="finite numbers"):
+        Displacement("bottom", (None, 0.0))
+    with pytest.raises(InputError, match="finite numbers"):
+        Pressure("bottom", float("nan"))
     with pytest.raises(InputError, match="value has shape"):
         values(Displacement("top", lambda x, t: np.zeros(5), (0,)), X, 0.0)
     with pytest.raises(InputError, match="pass n"):

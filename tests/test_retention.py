@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from rkfx.errors import InputError
-from rkfx.materials.retention import GAMMA_W, Liakopoulos, Retention, VanGenuchten, storage
+from rkfx.materials.retention import GAMMA_W, Liakopoulos, Retention, VanGenuchten, storage, storage_slope
 
 LAWS = [Liakopoulos(), Liakopoulos.lewis_schrefler(), VanGenuchten(S_rw=0.0842, n=2.0, beta=0.7)]
 
@@ -14,7 +14,7 @@ def test_saturated_at_and_below_zero_suction(law):
     assert isinstance(law, Retention)
     s = np.array([-5e3, -1.0, 0.0])
     assert np.all(law.saturation(s) == 1.0) and np.all(law.relative_permeability(s) == 1.0)
-    assert np.all(law.saturation_slope(s) == 0.0)
+    assert np.all(law.saturation_slope(s) == 0.0) and np.all(law.relative_permeability_slope(s) == 0.0)
 
 
 @pytest.mark.parametrize("law", LAWS)
@@ -24,6 +24,21 @@ def test_slope_is_the_derivative(law):
     fd = (law.saturation(s + h) - law.saturation(s - h)) / (2 * h)
     assert np.allclose(law.saturation_slope(s), fd, rtol=1e-6)
     assert np.all(np.diff(law.saturation(s)) < 0) and np.all(np.diff(law.relative_permeability(s)) <= 0)
+
+
+@pytest.mark.parametrize("law", LAWS)
+def test_permeability_and_storage_slopes_are_the_derivatives(law):
+    s = np.linspace(500.0, 1.2e4, 40)
+    h = 1e-3 * s
+    fd = (law.relative_permeability(s + h) - law.relative_permeability(s - h)) / (2 * h)
+    live = law.relative_permeability(s) > law.k_min
+    assert live.sum() > 10
+    assert np.allclose(law.relative_permeability_slope(s)[live], fd[live], rtol=1e-5)
+    assert np.all(law.relative_permeability_slope(s[~live]) == 0.0)
+    p = -s
+    args = (0.3, 1.0, 2e9, 1e12)
+    fd = (storage(law, p + h, *args) - storage(law, p - h, *args)) / (2 * h)
+    assert np.allclose(storage_slope(law, p, *args), fd, rtol=1e-3)
 
 
 def test_the_two_liakopoulos_forms():

@@ -6,6 +6,7 @@ s = -p_w; s <= 0 is saturated), evaluated in bulk over arrays:
     saturation(s)            S_w in (0, 1]
     saturation_slope(s)      dS_w / ds  (<= 0; dS_w / dp_w = -dS_w / ds)
     relative_permeability(s) k_rw in (0, 1], scaling the permeability k^w = (k_rw / mu_w) k_in (6.14)
+    relative_permeability_slope(s)  dk_rw / ds (0 where k_rw is floored)
 
 Laws:
 
@@ -45,6 +46,8 @@ class Retention(Protocol):
     def saturation_slope(self, s: np.ndarray) -> np.ndarray: ...
 
     def relative_permeability(self, s: np.ndarray) -> np.ndarray: ...
+
+    def relative_permeability_slope(self, s: np.ndarray) -> np.ndarray: ...
 
 
 def _positive(name: str, value: float) -> None:
@@ -90,6 +93,12 @@ class Liakopoulos:
     def relative_permeability(self, s):
         return np.maximum(1.0 - self.c * (1.0 - self.saturation(s)) ** self.d, self.k_min)
 
+    def relative_permeability_slope(self, s):
+        dry = 1.0 - self.saturation(s)
+        slope = self.c * self.d * dry ** (self.d - 1.0) * self.saturation_slope(s) if self.d != 1.0 \
+            else self.c * self.saturation_slope(s)
+        return np.where(1.0 - self.c * dry ** self.d > self.k_min, slope, 0.0)
+
 
 @dataclass(frozen=True)
 class VanGenuchten:
@@ -130,10 +139,37 @@ class VanGenuchten:
         dse_dx = -self.m * self.n * x ** (self.n - 1.0) * (1.0 + x ** self.n) ** (-self.m - 1.0)
         return (1.0 - self.S_rw) * dse_dx * self.beta / self.gamma_w
 
+    def _mualem(self, x, slope: bool = False):
+        """k_rw before the floor (and dk_rw/dx with ``slope``), with 1 - S_e^(1/m) = x^n / (1 + x^n) written out
+        (no cancellation near saturation)."""
+        n, m = self.n, self.m
+        xn = x ** n
+        se = (1.0 + xn) ** -m
+        f = 1.0 - (xn / (1.0 + xn)) ** m
+        if not slope:
+            return np.sqrt(se) * f * f
+        dse = -m * n * x ** (n - 1.0) * (1.0 + xn) ** (-m - 1.0)
+        df = -m * n * x ** (n * m - 1.0) * (1.0 + xn) ** (-m - 1.0)
+        return np.sqrt(se) * f * f, 0.5 * dse * f * f / np.sqrt(se) + 2.0 * np.sqrt(se) * f * df
+
     def relative_permeability(self, s):
-        se = self.effective_saturation(s)
-        k = np.sqrt(se) * (1.0 - (1.0 - se ** (1.0 / self.m)) ** self.m) ** 2
-        return np.maximum(k, self.k_min)
+        return np.maximum(self._mualem(self._x(s)), self.k_min)
+
+    def relative_permeability_slope(self, s):
+        """dk_rw/ds: 0 while saturated (s <= 0); from the dry side of s = 0 it is finite for
+        n >= 2 and taken at x = 1e-12 (it is unbounded there for n < 2)."""
+        x = self._x(s)
+        k, dk = self._mualem(np.maximum(x, 1e-12), slope=True)
+        return np.where((k > self.k_min) & (x > 0), dk * self.beta / self.gamma_w, 0.0)
+
+
+def storage_slope(law: Retention, p_w, porosity: float, alpha: float, K_w: float, K_s: float) -> np.ndarray:
+    """d(1/Q)/dp_w [1/Pa^2] by central differences of ``storage`` (steps of 1e-4 gamma_w, or
+    1e-6 |p_w| where larger), for Newton's Jacobian."""
+    p_w = np.asarray(p_w, float)
+    h = np.maximum(1e-4 * getattr(law, "gamma_w", GAMMA_W), 1e-6 * np.abs(p_w))
+    return (storage(law, p_w + h, porosity, alpha, K_w, K_s) - storage(law, p_w - h, porosity, alpha, K_w, K_s)) \
+        / (2.0 * h)
 
 
 def storage(law: Retention, p_w, porosity: float, alpha: float, K_w: float, K_s: float) -> np.ndarray:
