@@ -1,0 +1,139 @@
+"""Unsaturated u-p poroelasticity with gravity in dolfinx: the FEM baseline of the Liakopoulos
+column (the equations of ``rkfx.models.unsaturated_poroelasticity``, eqs. 6.15-6.16).
+
+Taylor-Hood (P2-P1 or Q2-Q1) with the Galerkin forms
+
+    F_u = int sigma''(u) : eps(v) - alpha S p div v - n rho_w (S - 1) g . v
+    F_p = int k k_rw (grad p - S rho_w g) . grad q
+    c   = int q (alpha S div u' + p' / Q)
+
+and their exact derivatives (d(1/Q)/dp by central differences, as in the RKPM model). The
+coefficients S_w, k_rw, 1/Q and their slopes are the retention law's numpy functions
+(``rkfx.materials.retention``) evaluated at the quadrature points of a quadrature space and
+held there as Functions, so the physics is written once; the forms take the same quadrature
+degree. The model reuses :class:`fem_baselines.poroelasticity.FemBiotModel` for the numbering,
+the boundary conditions and the gathering into scipy CSR, and is stepped by ``rkfx.solvers``
+like the RKPM model (``rate_force`` for the state-dependent capacity).
+"""
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import dolfinx_solver  # noqa: F401  (must precede dolfinx / petsc4py: orders MPI loading)
+
+import basix.ufl
+import numpy as np
+import scipy.sparse as sp
+
+import dolfinx
+import dolfinx.fem
+import ufl
+
+from fem_baselines.elasticity import strain, stress_law
+from fem_baselines.poroelasticity import FemBiotModel, _global_matrix, _global_vector
+from rkfx.conditions import Condition
+from rkfx.models.unsaturated_poroelasticity import UnsaturatedSoil
+
+#: Names of the coefficient Functions on the quadrature space (``UnsaturatedSoil.coefficients``).
+COEFFICIENTS = ("S", "dS", "kr", "dkr", "iQ", "diQ")
+
+
+class FemUnsaturatedModel(FemBiotModel):
+    """The unsaturated u-p equations on a Taylor-Hood mesh, as a model of ``rkfx.solvers``.
+
+    Args:
+        mesh: A 2-D dolfinx mesh.
+        soil: Constituents, retention law and gravity (g along -y).
+        conditions: ``rkfx.conditions`` (Displacement, Pressure; Traction and Flux as loads).
+        quadrature_degree: Of every form and of the coefficient space.
+    """
+
+    def __init__(self, mesh: dolfinx.mesh.Mesh, soil: UnsaturatedSoil, conditions: Sequence[Condition],
+                 quadrature_degree: int = 4):
+        m = soil.medium
+        mat = m.material
+        super().__init__(mesh, m.E, m.nu, m.k, mat.alpha, mat.S, "taylor-hood", conditions)
+        self.soil, self.linear = soil, False
+        cell = mesh.topology.cell_name()
+        W = dolfinx.fem.functionspace(mesh, basix.ufl.quadrature_element(cell, value_shape=(), degree=quadrature_degree))
+        self.W = W
+        self.uh, self.ph = dolfinx.fem.Function(self.V), dolfinx.fem.Function(self.Q)
+        self.vu, self.vp = dolfinx.fem.Function(self.V), dolfinx.fem.Function(self.Q)
+        self.coef = {name: dolfinx.fem.Function(W, name=name) for name in COEFFICIENTS}
+        self._p_at = dolfinx.fem.Expression(self.ph, W.element.interpolation_points)
+        self._pq = dolfinx.fem.Function(W)
+        dx = ufl.dx(domain=mesh, metadata={"quadrature_degree": quadrature_degree})
+        scalar = dolfinx.default_scalar_type
+        const = lambda value: dolfinx.fem.Constant(mesh, scalar(value))  # noqa: E731
+        alpha, n, rho, k = const(mat.alpha), const(m.porosity), const(m.rho_f), const(m.k)
+        g = dolfinx.fem.Constant(mesh, np.array([0.0, -soil.gravity], dtype=scalar))
+        S, dS, kr, dkr, iQ, diQ = (self.coef[c] for c in COEFFICIENTS)
+        sigma = stress_law(mesh, mat.elastic)
+        u, p = self.uh, self.ph
+        v, q = ufl.TestFunction(self.V), ufl.TestFunction(self.Q)
+        du, dp = ufl.TrialFunction(self.V), ufl.TrialFunction(self.Q)
+        flux = grad_p = ufl.grad(p) - S * rho * g
+        form = dolfinx.fem.form
+        self._F_u = form((ufl.inner(sigma(u), strain(v)) - alpha * S * p * ufl.div(v)
+                          - n * rho * (S - 1.0) * ufl.inner(g, v)) * dx)
+        self._F_p = form(k * kr * ufl.inner(flux, ufl.grad(q)) * dx)
+        self._J_uu = form(ufl.inner(sigma(du), strain(v)) * dx)
+        self._J_up = form((-alpha * (S + dS * p) * dp * ufl.div(v) - n * rho * dS * dp * ufl.inner(g, v)) * dx)
+        self._J_pp = form((k * kr * ufl.inner(ufl.grad(dp), ufl.grad(q)) + k * dkr * dp * ufl.inner(grad_p, ufl.grad(q))
+                           - k * kr * dS * dp * rho * ufl.inner(g, ufl.grad(q))) * dx)
+        self._c_p = form(q * (alpha * S * ufl.div(self.vu) + iQ * self.vp) * dx)
+        self._C_x = form(q * (alpha * dS * ufl.div(self.vu) + diQ * self.vp) * dp * dx)
+        self._C_vu = form(q * alpha * S * ufl.div(du) * dx)
+        self._C_vp = form(q * iQ * dp * dx)
+        self._kuu = _global_matrix(self._J_uu, self.comm)
+
+    # ------------------------------------------------------------------ state
+
+    def _set(self, x: np.ndarray) -> None:
+        """u_h, p_h and the coefficients at the quadrature points from the unknowns."""
+        self.assign(x, self.uh, self.ph)
+        self._pq.interpolate(self._p_at)
+        values = self.soil.coefficients(self._pq.x.array)
+        for name in COEFFICIENTS:
+            self.coef[name].x.array[:] = values[name]
+
+    def _blocks(self, uu, up, pu, pp) -> sp.csr_matrix:
+        n_u, n_p = self._n_u, self.layout.size - self._n_u
+        zero = lambda r, c: sp.csr_matrix((r, c))  # noqa: E731
+        return sp.bmat([[uu if uu is not None else zero(n_u, n_u), up if up is not None else zero(n_u, n_p)],
+                        [pu if pu is not None else zero(n_p, n_u), pp if pp is not None else zero(n_p, n_p)]],
+                       format="csr")
+
+    # ------------------------------------------------------------------ model
+
+    def residual(self, x: np.ndarray, t: float) -> np.ndarray:
+        self._set(x)
+        self._t_trial = t
+        r = np.r_[_global_vector(self._F_u, self.comm), _global_vector(self._F_p, self.comm)]
+        return r - self.loads(t)
+
+    def tangent(self, x: np.ndarray, t: float) -> sp.csr_matrix:
+        return self._blocks(self._kuu, _global_matrix(self._J_up, self.comm), None,
+                            _global_matrix(self._J_pp, self.comm))
+
+    def rate_force(self, x: np.ndarray, v: np.ndarray) -> np.ndarray:
+        self._set(x)
+        self.assign(v, self.vu, self.vp)
+        return np.r_[np.zeros(self._n_u), _global_vector(self._c_p, self.comm)]
+
+    def rate_tangents(self) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        dx = self._blocks(None, None, None, _global_matrix(self._C_x, self.comm))
+        dv = self._blocks(None, None, _global_matrix(self._C_vu, self.comm), _global_matrix(self._C_vp, self.comm))
+        return dx, dv
+
+    def capacity(self, dt: float) -> None:
+        return None
+
+    def equation_weights(self, co) -> None:
+        return None
+
+    def pressure_function(self, x: np.ndarray) -> dolfinx.fem.Function:
+        """p_h of the unknowns ``x`` (a new Function)."""
+        ph = dolfinx.fem.Function(self.Q)
+        ph.x.array[:] = x[self.p_index]
+        return ph
