@@ -224,6 +224,10 @@ ROWS: list[Row] = [
                                 ("grains softer than the skeleton", "K_s=1e8"), ("Courant number above 1", "courant=1.5"),
                                 ("too few nodes along the height", "ny=3"), ("exclusion wider than the history", "exclude=1")]),
     Row("too big for memory", "wave_column", ("--set", "ny=99999999")),
+    *_case_rows("liakopoulos", [("unknown retention law", "retention=vg"),
+                                ("grid not whole across the column", "ny=20"),
+                                ("probe above the column", "probes=1.5"), ("zero largest step", "max_step=0")]),
+    Row("too big for memory", "liakopoulos", ("--set", "ny=99999991")),
     # --- geometry files ---
     Row("broken .geo file", "", code="from_geo('broken.geo')", setup=_file("broken.geo", BROKEN_GEO)),
     Row(".geo file with an undefined point", "", code="from_geo('undefined.geo')",

@@ -25,4 +25,6 @@ the machine cannot hold it), see ``rkfx.cases._preflight``.
                       fracture by the coupled damage particle method.
     wave_column       waves in a saturated u-p column (seed 6.4.1): explicit RKPM on NSNI and
                       DNI, Taylor-Hood with the trapezoid, the exact Laplace-domain solution.
+    liakopoulos       unsaturated drainage of a sand column (seed 6.4.2): implicit RKPM u-p on
+                      NSNI with the retention law against Taylor-Hood on the same grid.
 """

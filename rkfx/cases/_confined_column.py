@@ -1,25 +1,54 @@
-"""The RKPM model of the laterally confined u-p column of §6.4.1, for the wave-column study.
+"""RKPM discretizations of laterally confined u-p columns (§6.4.1 and §6.4.2).
 
-A column 0 <= y <= L of three nodes across (rollers on both sides), the base fixed in y and
-impermeable, the top drained (p = 0) and loaded by a compressive traction q from t = 0. The
-nodes are a uniform grid, a = 2 h, the cells their median-dual areas as squares, and the rule
-any of ``rkfx.integration.nodal_stabilized.RULES``.
+``column_discretization``: a uniform grid of nodes on [0, W] x [0, L], a = 2 h, the cells
+their median-dual areas as squares, and any rule of ``rkfx.integration.nodal_stabilized.RULES``.
+
+``confined_column``: the wave-column model, three nodes across (rollers on both sides), the
+base fixed in y and impermeable, the top drained (p = 0) and loaded by a compressive traction
+q from t = 0.
 """
 from typing import NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
 
-from rkfx.approximation.semi_lagrangian import evaluate_moving, moving_rk
+from rkfx.approximation.semi_lagrangian import MovingRK, evaluate_moving, moving_rk
+from rkfx.errors import InputError
 from rkfx.geometry.nodal_domains import nodal_domains
-from rkfx.geometry.particles import structured
-from rkfx.integration.nodal_stabilized import boundary_rule, nodal_cells, nodal_integration
+from rkfx.geometry.particles import Particles, structured
+from rkfx.integration.nodal_stabilized import NodalIntegration, boundary_rule, nodal_cells, nodal_integration
 from rkfx.models.explicit_poroelasticity import Constituents, ExplicitPoroDynamics, collocation_rows
 from rkfx.solvers.central_difference import Constraint
 
 #: The data of §6.4.1 (Soares 2014).
 SOARES = Constituents(E=254423076.9, nu=0.298, rho_s=2700.0, rho_f=1000.0, porosity=0.48, k=3.55e-9,
                       K_s=1.1e10, K_f=3.3e9)
+
+
+class ColumnDiscretization(NamedTuple):
+    """Nodes, approximation and rule of a column, and its boundary nodes (indices)."""
+
+    particles: Particles
+    rk: MovingRK
+    rule: NodalIntegration
+    bottom: np.ndarray
+    top: np.ndarray
+    sides: np.ndarray
+
+
+def column_discretization(width: float, height: float, nx: int, ny: int, rule: str = "nsni") -> ColumnDiscretization:
+    """``nx`` x ``ny`` nodes on [0, width] x [0, height] with equal spacings h, a = 2 h."""
+    h = height / (ny - 1)
+    if abs(width / (nx - 1) - h) > 1e-9 * h:
+        raise InputError(f"nx = {nx}, ny = {ny} give unequal spacings {width / (nx - 1):.4g} and {h:.4g} m on a "
+                         f"{width} x {height} m column; take nx - 1 = (ny - 1) width / height")
+    p = structured(width, height, nx, ny)
+    cells = nodal_cells(p.x, nodal_domains(p).area)
+    rk = moving_rk(p.x, 2.0 * h, 0.5 * h, reach=cells.reach)
+    r = nodal_integration(rk, cells, boundary_rule(p.x, p.boundary_edges), rule)
+    x, tol = p.x, 1e-9 * height
+    return ColumnDiscretization(p, rk, r, np.flatnonzero(x[:, 1] < tol), np.flatnonzero(x[:, 1] > height - tol),
+                                np.flatnonzero((x[:, 0] < tol) | (x[:, 0] > width - tol)))
 
 
 class ConfinedColumn(NamedTuple):
@@ -51,16 +80,10 @@ def confined_column(ny: int, rule: str = "nsni", medium: Constituents = SOARES, 
         load: q [Pa], compressive, on the top from t = 0.
     """
     h = height / (ny - 1)
-    p = structured(2 * h, height, 3, ny)
-    cells = nodal_cells(p.x, nodal_domains(p).area)
-    rk = moving_rk(p.x, 2.0 * h, 0.5 * h, reach=cells.reach)
-    r = nodal_integration(rk, cells, boundary_rule(p.x, p.boundary_edges), rule)
+    p, rk, r, bottom, top, sides = column_discretization(2 * h, height, 3, ny, rule)
     x, n = p.x, p.num_nodes
     size = 3 * n
     tol = 1e-9 * height
-    bottom = np.flatnonzero(x[:, 1] < tol)
-    top = np.flatnonzero(x[:, 1] > height - tol)
-    sides = np.flatnonzero((x[:, 0] < tol) | (x[:, 0] > 2 * h - tol))
     essential = [Constraint(collocation_rows(rk, bottom, 1, n, 0, size)),      # u_y = 0 at the base
                  Constraint(collocation_rows(rk, sides, 0, n, 0, size)),       # rollers
                  Constraint(collocation_rows(rk, top, None, n, 2 * n, size))]  # drained top
