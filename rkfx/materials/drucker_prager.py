@@ -1,0 +1,166 @@
+"""Drucker-Prager plasticity in plane strain with the return map of an explicit stress update.
+
+Stresses are effective, tension positive, as arrays ``(m, 4)`` of (sigma_xx, sigma_yy,
+sigma_zz, sigma_xy); strain increments are Voigt ``(m, 3)`` (d eps_xx, d eps_yy, d gamma_xy)
+with d eps_zz = 0. With I_1 = tr sigma, s = sigma - I_1 I / 3 and J_2 = s : s / 2,
+
+    f = sqrt(J_2) + a_phi I_1 - k_c,      g = sqrt(J_2) + a_psi I_1   (plastic potential)
+
+and the constants fitted to Mohr-Coulomb in plane strain (the match at which associated flow
+gives Mohr-Coulomb's limit load; as Bui et al. 2008 use them for soil):
+
+    a_phi = tan(phi) / sqrt(9 + 12 tan^2 phi),   k_c = 3 c / sqrt(9 + 12 tan^2 phi),
+
+a_psi the same of the dilatancy angle psi (psi = phi: associated; psi = 0: no dilatancy).
+
+``update`` is one explicit step: the elastic trial sigma* = sigma + D d eps; where it lies
+beyond the apex of the cone (I_1* > k_c / a_phi, more tension than a cohesionless or weakly
+cohesive soil carries) its mean stress is brought back to the apex, the tension cut-off; then,
+where f(sigma*) > 0, the return along dg/dsigma,
+
+    d lambda = f* / (G + 9 K a_phi a_psi),  s = s* (1 - G d lambda / sqrt(J_2*)),
+    I_1 = I_1* - 9 K a_psi d lambda,
+
+which ends on f = 0 exactly; a return that would pass the apex ends at the apex. The
+equivalent plastic strain grows by sqrt(2/3) |dev d eps^p| = d lambda / sqrt(3). A rotation
+of the stress (the Jaumann rate of eq. 6.13) belongs to the model and is applied to sigma
+before ``update``.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from rkfx.errors import InputError
+from rkfx.materials.elasticity import ElasticMaterial
+
+
+def plane_strain_fit(angle_deg: float) -> float:
+    """tan(angle) / sqrt(9 + 12 tan^2 angle): a_phi (or a_psi) of the plane-strain match."""
+    t = np.tan(np.radians(angle_deg))
+    return float(t / np.sqrt(9.0 + 12.0 * t * t))
+
+
+def invariants(stress: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """I_1, sqrt(J_2) and the deviator s (m, 4) of stresses ``(m, 4)``."""
+    stress = np.asarray(stress, float)
+    i1 = stress[:, :3].sum(axis=1)
+    s = stress.copy()
+    s[:, :3] -= i1[:, None] / 3.0
+    j2 = 0.5 * (s[:, 0] ** 2 + s[:, 1] ** 2 + s[:, 2] ** 2) + s[:, 3] ** 2
+    return i1, np.sqrt(j2), s
+
+
+@dataclass(frozen=True)
+class StressUpdate:
+    """The end of an explicit step at every point.
+
+    Attributes:
+        stress: sigma_{n+1}, shape ``(m, 4)`` [Pa].
+        plastic_strain: Equivalent plastic strain after the step, shape ``(m,)``.
+        yielded: Points that returned to the cone (or its apex), shape ``(m,)``.
+    """
+
+    stress: np.ndarray
+    plastic_strain: np.ndarray
+    yielded: np.ndarray
+
+
+@dataclass(frozen=True)
+class DruckerPrager:
+    """An elastic-perfectly plastic Drucker-Prager soil in plane strain (see the module docstring).
+
+    Attributes:
+        E: Young's modulus [Pa].
+        nu: Poisson's ratio [-].
+        phi: Friction angle [degrees], in [0, 90).
+        c: Cohesion [Pa], >= 0.
+        psi: Dilatancy angle [degrees], in [0, phi].
+    """
+
+    E: float
+    nu: float
+    phi: float
+    c: float = 0.0
+    psi: float = 0.0
+
+    def __post_init__(self):
+        ElasticMaterial(self.E, self.nu)  # validates E and nu
+        if not 0.0 <= self.phi < 90.0:
+            raise InputError(f"friction angle phi = {self.phi!r} must lie in [0, 90) degrees")
+        if not (np.isfinite(self.c) and self.c >= 0.0):
+            raise InputError(f"cohesion c = {self.c!r} must be >= 0 Pa")
+        if not 0.0 <= self.psi <= self.phi:
+            raise InputError(f"dilatancy angle psi = {self.psi!r} must lie in [0, phi = {self.phi}] degrees")
+        if self.phi == 0.0 and self.c == 0.0:
+            raise InputError("phi = 0 and c = 0 leave the soil no strength; give a friction angle or a cohesion")
+
+    @property
+    def shear_modulus(self) -> float:
+        return self.E / (2.0 * (1.0 + self.nu))
+
+    @property
+    def bulk_modulus(self) -> float:
+        return self.E / (3.0 * (1.0 - 2.0 * self.nu))
+
+    @property
+    def a_phi(self) -> float:
+        return plane_strain_fit(self.phi)
+
+    @property
+    def a_psi(self) -> float:
+        return plane_strain_fit(self.psi)
+
+    @property
+    def k_c(self) -> float:
+        t = np.tan(np.radians(self.phi))
+        return float(3.0 * self.c / np.sqrt(9.0 + 12.0 * t * t))
+
+    @property
+    def apex(self) -> float:
+        """I_1 at the apex of the cone, k_c / a_phi (inf without friction) [Pa]."""
+        return self.k_c / self.a_phi if self.a_phi > 0 else np.inf
+
+    def yield_function(self, stress: np.ndarray) -> np.ndarray:
+        """f of stresses ``(m, 4)`` [Pa]."""
+        i1, q, _ = invariants(stress)
+        return q + self.a_phi * i1 - self.k_c
+
+    def elastic_increment(self, d_strain: np.ndarray) -> np.ndarray:
+        """D d eps in the (xx, yy, zz, xy) components, shape ``(m, 4)`` [Pa]."""
+        d = np.asarray(d_strain, float)
+        G, K = self.shear_modulus, self.bulk_modulus
+        lam = K - 2.0 * G / 3.0
+        tr = d[:, 0] + d[:, 1]
+        return np.column_stack([lam * tr + 2 * G * d[:, 0], lam * tr + 2 * G * d[:, 1], lam * tr, G * d[:, 2]])
+
+    def update(self, stress: np.ndarray, d_strain: np.ndarray, plastic_strain: np.ndarray) -> StressUpdate:
+        """One explicit step from ``stress`` (m, 4) by the strain increments ``d_strain`` (m, 3)."""
+        stress, d_strain = np.asarray(stress, float), np.asarray(d_strain, float)
+        if stress.ndim != 2 or stress.shape[1] != 4 or d_strain.shape != (len(stress), 3):
+            raise InputError(f"stresses {stress.shape} and strain increments {d_strain.shape}: give (m, 4) "
+                             "(xx, yy, zz, xy) and (m, 3) (xx, yy, gamma_xy)")
+        G, K, a, b, k = self.shear_modulus, self.bulk_modulus, self.a_phi, self.a_psi, self.k_c
+        trial = stress + self.elastic_increment(d_strain)
+        i1, q, s = invariants(trial)
+        yielded = np.zeros(len(trial), bool)
+        # Tension cut-off: the mean stress back to the apex.
+        over = i1 > self.apex
+        if over.any():
+            i1 = np.where(over, self.apex, i1)
+            yielded |= over
+        f = q + a * i1 - k
+        dlam = np.zeros(len(trial))
+        ret = f > 1e-12 * max(k, 1.0) + 1e-14 * np.abs(i1)
+        if ret.any():
+            dlam[ret] = f[ret] / (G + 9.0 * K * a * b)
+            i1 = np.where(ret, i1 - 9.0 * K * b * dlam, i1)
+            scale = np.where(ret, 1.0 - G * dlam / np.where(q > 0, q, 1.0), 1.0)
+            past = ret & (scale < 0.0)  # beyond the apex: end there
+            scale = np.maximum(scale, 0.0)
+            if past.any():
+                i1 = np.where(past, self.apex if np.isfinite(self.apex) else i1, i1)
+            s = s * scale[:, None]
+            yielded |= ret
+        out = s.copy()
+        out[:, :3] += i1[:, None] / 3.0
+        return StressUpdate(out, np.asarray(plastic_strain, float) + dlam / np.sqrt(3.0), yielded)

@@ -1,0 +1,77 @@
+"""Drucker-Prager return map (plane strain): elastic inside the cone, on the cone after a
+return, Mohr-Coulomb's limit in a plane-strain biaxial test with associated flow, the tension
+cut-off of a cohesionless soil, the plastic strain, and bad parameters named."""
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from rkfx.errors import InputError
+from rkfx.materials.drucker_prager import DruckerPrager, invariants
+
+SOIL = DruckerPrager(E=1.0e7, nu=0.3, phi=20.0, c=300.0)
+
+
+def test_elastic_inside_the_cone():
+    s0 = np.array([[-1e4, -2e4, -1.5e4, 1e3]])
+    d = np.array([[1e-6, -2e-6, 5e-7]])
+    out = SOIL.update(s0, d, np.zeros(1))
+    assert np.allclose(out.stress, s0 + SOIL.elastic_increment(d)) and not out.yielded[0]
+    assert out.plastic_strain[0] == 0.0
+
+
+@pytest.mark.parametrize("psi", [0.0, 10.0, 20.0])
+def test_returns_onto_the_cone(psi):
+    soil = DruckerPrager(E=1.0e7, nu=0.3, phi=20.0, c=300.0, psi=psi)
+    rng = np.random.default_rng(0)
+    s0 = np.column_stack([-1e4 * np.ones(50), -1e4 * np.ones(50), -1e4 * np.ones(50), np.zeros(50)])
+    d = 1e-2 * rng.standard_normal((50, 3))
+    out = soil.update(s0, d, np.zeros(50))
+    f = soil.yield_function(out.stress)
+    assert np.all(f <= 1e-8 * 1e4)
+    on = out.yielded & (invariants(out.stress)[1] > 0)
+    assert on.sum() > 20 and np.all(np.abs(f[on]) < 1e-8 * 1e4)
+    assert np.all(out.plastic_strain[out.yielded] > 0) and np.all(out.plastic_strain[~out.yielded] == 0)
+    # the volumetric change of the return is the dilatancy's: none for psi = 0
+    i1_trial = invariants(s0 + soil.elastic_increment(d))[0]
+    moved = on & (i1_trial < soil.apex)
+    if psi == 0.0:
+        assert np.allclose(invariants(out.stress)[0][moved], i1_trial[moved])
+    else:
+        assert np.all(invariants(out.stress)[0][moved] < i1_trial[moved])
+
+
+def test_plane_strain_biaxial_reaches_mohr_coulomb():
+    """Associated flow: the limit stress of a plane-strain test under a held confining stress
+    meets Mohr-Coulomb's (sigma_1 - sigma_3) / 2 = c cos phi - (sigma_1 + sigma_3) / 2 sin phi."""
+    soil = DruckerPrager(E=1.0e7, nu=0.3, phi=30.0, c=1000.0, psi=30.0)
+    p0 = 2.0e4
+    s = np.array([[-p0, -p0, -p0, 0.0]])
+    eps_p = np.zeros(1)
+    for _ in range(1500):
+        def sxx(dx):
+            return soil.update(s, np.array([[dx, -2e-5, 0.0]]), eps_p).stress[0, 0] + p0
+        dx = brentq(sxx, -1e-3, 1e-3, xtol=1e-16)
+        out = soil.update(s, np.array([[dx, -2e-5, 0.0]]), eps_p)
+        s, eps_p = out.stress, out.plastic_strain
+    s1, s3 = s[0, 0], s[0, 1]  # the confined side is the larger (less compressive) principal stress
+    phi = np.radians(30.0)
+    lhs, rhs = 0.5 * (s1 - s3), 1000.0 * np.cos(phi) - 0.5 * (s1 + s3) * np.sin(phi)
+    assert lhs == pytest.approx(rhs, rel=1e-6)
+    assert eps_p[0] > 1e-3
+
+
+def test_tension_cut_off_without_cohesion():
+    sand = DruckerPrager(E=1.0e7, nu=0.3, phi=30.0, c=0.0)
+    out = sand.update(np.zeros((1, 4)), np.array([[1e-3, 1e-3, 0.0]]), np.zeros(1))
+    assert np.allclose(out.stress, 0.0, atol=1e-9) and out.yielded[0]
+
+
+@pytest.mark.parametrize("kw, word", [(dict(phi=95.0), "friction"), (dict(c=-1.0), "cohesion"),
+                                      (dict(psi=25.0), "dilatancy"), (dict(phi=0.0, c=0.0), "no strength"),
+                                      (dict(nu=0.5), "nu")])
+def test_bad_parameters_named(kw, word):
+    args = dict(E=1e7, nu=0.3, phi=20.0, c=300.0) | kw
+    with pytest.raises(InputError, match=word):
+        DruckerPrager(**args)
+    with pytest.raises(InputError, match="stresses"):
+        SOIL.update(np.zeros((2, 3)), np.zeros((2, 3)), np.zeros(2))
