@@ -102,3 +102,17 @@ def test_bad_parameters_are_named(kw, word):
     args = dict(support=0.4) | kw
     with pytest.raises(InputError, match=word):
         moving_rk(p.x, **args)
+
+
+def test_torn_points_get_shepard_rows_when_counted():
+    """Collinear neighbours: a singular moment matrix raises, or gives the constant-basis row."""
+    x = np.array([[0.0, 0.0], [0.1, 0.0], [0.2, 0.0], [0.3, 0.0]])
+    with pytest.raises(SingularMomentMatrix):
+        evaluate_moving(moving_rk(x, 0.25, 0.02), gradients=True)
+    counter = np.zeros(1, np.int64)
+    rows = evaluate_moving(moving_rk(x, 0.25, 0.02, torn=counter), gradients=True)
+    assert counter[0] == 4
+    assert np.allclose(rows.matrix(0).sum(axis=1).A.ravel(), 1.0)
+    assert np.array_equal(rows.data[:, 1:], np.zeros_like(rows.data[:, 1:]))
+    with pytest.raises(InputError, match="counter"):
+        moving_rk(x, 0.25, 0.02, torn=[0])

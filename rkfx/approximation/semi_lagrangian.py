@@ -39,6 +39,13 @@ class MovingRK:
         skin: Extra search radius [m]; a row stays valid while nodes move less than skin / 2.
         reach: Largest distance of an evaluation point from the node whose row it uses [m].
         searched: Rows searched when this state was made (all of them for a new one).
+        torn: ``None``: a point whose moment matrix is singular (too few or collinear
+            neighbours) raises ``SingularMomentMatrix``. Otherwise a one-element int64 counter:
+            such a point, and one whose scaled moment matrix has a reciprocal condition below
+            ``TORN_RCOND``, gets the constant-basis (Shepard) row instead, N_I = phi_I / sum phi
+            with zero gradients, and the counter grows by one. This is the choice for a
+            cohesionless material whose grains may leave the bulk: a torn-off particle then
+            carries no strain and flies until it rejoins neighbours.
     """
 
     x: np.ndarray
@@ -49,6 +56,7 @@ class MovingRK:
     skin: float
     reach: float
     searched: int
+    torn: np.ndarray | None = None
 
     @property
     def num_nodes(self) -> int:
@@ -59,7 +67,8 @@ def _search_radius(support: np.ndarray, skin: float, reach: float) -> np.ndarray
     return support + (skin + reach)
 
 
-def moving_rk(x: np.ndarray, support: np.ndarray, skin: float, reach: float = 0.0) -> MovingRK:
+def moving_rk(x: np.ndarray, support: np.ndarray, skin: float, reach: float = 0.0,
+              torn: np.ndarray | None = None) -> MovingRK:
     """Candidate rows of every node at positions ``x``.
 
     Args:
@@ -69,6 +78,8 @@ def moving_rk(x: np.ndarray, support: np.ndarray, skin: float, reach: float = 0.
             0.5 of the nodal spacing).
         reach: Farthest evaluation point from its node [m] (0 when shape functions are needed at
             the nodes only; the half-diagonal of a smoothing cell for SNNI).
+        torn: ``None`` to raise at singular points, or a one-element int64 counter for the
+            Shepard rows of torn-off points (see ``MovingRK``).
     """
     x = np.ascontiguousarray(x, dtype=np.float64)
     if x.ndim != 2 or x.shape[1] != 2:
@@ -81,7 +92,9 @@ def moving_rk(x: np.ndarray, support: np.ndarray, skin: float, reach: float = 0.
     if not (np.isfinite(reach) and reach >= 0):
         raise InputError(f"reach = {reach!r}: must be a length >= 0")
     indptr, indices = support_neighbours(x, _search_radius(support, skin, reach), x)
-    return MovingRK(x, support, x.copy(), indptr, indices, float(skin), float(reach), len(x))
+    if torn is not None and (not isinstance(torn, np.ndarray) or torn.shape != (1,) or torn.dtype != np.int64):
+        raise InputError("torn must be None or a one-element int64 counter, np.zeros(1, np.int64)")
+    return MovingRK(x, support, x.copy(), indptr, indices, float(skin), float(reach), len(x), torn)
 
 
 @numba.njit(parallel=True, cache=True)
@@ -113,7 +126,7 @@ def moved(rk: MovingRK, x: np.ndarray) -> MovingRK:
     d = x - rk.reference
     far = np.flatnonzero(d[:, 0] ** 2 + d[:, 1] ** 2 > (0.5 * rk.skin) ** 2)
     if far.size == 0:
-        return MovingRK(x, rk.support, rk.reference, rk.indptr, rk.indices, rk.skin, rk.reach, 0)
+        return MovingRK(x, rk.support, rk.reference, rk.indptr, rk.indices, rk.skin, rk.reach, 0, rk.torn)
     reference = rk.reference.copy()
     reference[far] = x[far]
     radius = _search_radius(rk.support, rk.skin, rk.reach)
@@ -132,7 +145,7 @@ def moved(rk: MovingRK, x: np.ndarray) -> MovingRK:
     np.cumsum(counts, out=out_ptr[1:])
     out_idx = np.empty(out_ptr[-1], np.int32)
     _spliced(rk.indptr, rk.indices, new_ptr, new_idx, slot, out_ptr, out_idx)
-    return MovingRK(x, rk.support, reference, out_ptr, out_idx, rk.skin, rk.reach, len(rows))
+    return MovingRK(x, rk.support, reference, out_ptr, out_idx, rk.skin, rk.reach, len(rows), rk.torn)
 
 
 @numba.njit(inline="always")
@@ -174,8 +187,27 @@ def _count_listed(x, a, points, owner, cand_ptr, cand_idx, counts):
             counts[p] = k
 
 
+#: With a ``torn`` counter, points whose scaled moment matrix is this close to singular get the
+#: Shepard row: near-collinear neighbours give gradients large enough to turn a particle
+#: inside out in one step long before the matrix is singular to round-off.
+TORN_RCOND = 1e-4
+
+
+@numba.njit(inline="always")
+def _shepard_row(n, idx, phis, base, indices, out):
+    """Constant-basis entries N = phi / sum(phi) and zero derivatives, written at ``base``."""
+    total = 0.0
+    for k in range(n):
+        total += phis[k]
+    for k in range(n):
+        indices[base + k] = idx[k]
+        out[base + k, 0] = phis[k] / total if total > 0.0 else 1.0 / n
+        for c in range(1, out.shape[1]):
+            out[base + k, c] = 0.0
+
+
 @numba.njit(parallel=True, cache=True)
-def _rows_listed(x, a, points, owner, scale, cand_ptr, cand_idx, indptr, kmax, mode, indices, out, ratio):
+def _rows_listed(x, a, points, owner, scale, cand_ptr, cand_idx, indptr, kmax, mode, indices, out, ratio, shepard):
     m = points.shape[0]
     for c in numba.prange((m + CHUNK - 1) // CHUNK):
         idx = np.empty(kmax, np.int64)
@@ -189,6 +221,9 @@ def _rows_listed(x, a, points, owner, scale, cand_ptr, cand_idx, indptr, kmax, m
             n = _gather_listed(points[p, 0], points[p, 1], x, a, cand_idx, cand_ptr[o], cand_ptr[o + 1],
                                idx, dxs, dys, phis, dphis, inv)
             ratio[p] = linear_row(n, idx, dxs, dys, phis, dphis, inv, mode, indptr[p], indices, out)
+            if shepard > 0.0 and not ratio[p] >= shepard and n > 0:
+                _shepard_row(n, idx, phis, indptr[p], indices, out)
+                ratio[p] = -1.0
 
 
 def evaluate_moving(rk: MovingRK, points: np.ndarray | None = None, owner: np.ndarray | None = None,
@@ -236,8 +271,10 @@ def evaluate_moving(rk: MovingRK, points: np.ndarray | None = None, owner: np.nd
     # Basis scale: any length of the order of the supports; N_I does not depend on it.
     scale = float(np.median(rk.support))
     _rows_listed(rk.x, rk.support, points, owner, scale, rk.indptr, rk.indices, indptr, kmax, mode,
-                 indices, out, ratio)
-    bad = np.flatnonzero(~(ratio >= RCOND_MIN))
+                 indices, out, ratio, TORN_RCOND if rk.torn is not None else 0.0)
+    if rk.torn is not None:
+        rk.torn[0] += int(np.count_nonzero(ratio == -1.0))
+    bad = np.flatnonzero(~((ratio >= RCOND_MIN) | ((ratio == -1.0) & (rk.torn is not None))))
     if bad.size:
         p = bad[0]
         raise SingularMomentMatrix(
