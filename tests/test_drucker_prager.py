@@ -75,3 +75,23 @@ def test_bad_parameters_named(kw, word):
         DruckerPrager(**args)
     with pytest.raises(InputError, match="stresses"):
         SOIL.update(np.zeros((2, 3)), np.zeros((2, 3)), np.zeros(2))
+
+
+def test_tangent_increment_is_the_rate_of_the_return():
+    """On the cone, C_T : d eps matches (update(sigma, h d eps) - sigma) / h as h -> 0."""
+    soil = DruckerPrager(E=1e6, nu=0.3, phi=30.0, c=500.0, psi=10.0)
+    rng = np.random.default_rng(3)
+    start = soil.update(np.tile([-2e3, -5e3, -3e3, 0.0], (40, 1)), rng.normal(size=(40, 3)) * 2e-2,
+                        np.zeros(40))
+    on = start.yielded & (invariants(start.stress)[1] > 1.0)
+    assert on.sum() > 20
+    sig = start.stress[on]
+    d = rng.normal(size=(on.sum(), 3))
+    # loading directions: those whose elastic trial leaves the cone
+    load = soil.yield_function(sig + 1e-6 * soil.elastic_increment(d)) > 0
+    h = 1e-7
+    rate = (soil.update(sig[load], h * d[load], np.zeros(load.sum())).stress - sig[load]) / h
+    tangent = soil.tangent_increment(sig[load], np.ones(load.sum(), bool), d[load])
+    assert load.sum() > 5
+    assert np.abs(rate - tangent).max() < 1e-4 * np.abs(tangent).max()
+    assert np.array_equal(soil.tangent_increment(sig, np.zeros(len(sig), bool), d), soil.elastic_increment(d))

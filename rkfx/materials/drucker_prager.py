@@ -164,3 +164,31 @@ class DruckerPrager:
         out = s.copy()
         out[:, :3] += i1[:, None] / 3.0
         return StressUpdate(out, np.asarray(plastic_strain, float) + dlam / np.sqrt(3.0), yielded)
+
+    def tangent_increment(self, stress: np.ndarray, yielded: np.ndarray, d_strain: np.ndarray) -> np.ndarray:
+        """C_T : d eps at the stresses of an update, shape ``(m, 4)`` [Pa].
+
+        Off the cone C_T is the elastic D; on it the continuum elastic-plastic tangent
+        D - (D : n_g)(n_f : D) / (n_f : D : n_g) with n_f, n_g the gradients of f and g
+        (n_f : D : n_g = G + 9 K a_phi a_psi, the denominator of the return); at the apex 0.
+        It is not symmetric for non-associated flow (psi < phi).
+        """
+        out = self.elastic_increment(d_strain)
+        yielded = np.asarray(yielded, bool)
+        if not yielded.any():
+            return out
+        G, K, a, b = self.shear_modulus, self.bulk_modulus, self.a_phi, self.a_psi
+        d = np.asarray(d_strain, float)
+        i1, q, s = invariants(stress)
+        tiny = 1e-9 * np.maximum(np.abs(i1), max(self.k_c, 1e-300))
+        cone = yielded & (q > tiny)
+        apex = yielded & ~cone
+        if cone.any():
+            sc, qc, dc = s[cone], q[cone], d[cone]
+            s_de = sc[:, 0] * dc[:, 0] + sc[:, 1] * dc[:, 1] + sc[:, 3] * dc[:, 2]
+            nf_de = G * s_de / qc + 3.0 * K * a * (dc[:, 0] + dc[:, 1])
+            d_ng = G * sc / qc[:, None]
+            d_ng[:, :3] += 3.0 * K * b
+            out[cone] -= d_ng * (nf_de / (G + 9.0 * K * a * b))[:, None]
+        out[apex] = 0.0
+        return out
