@@ -1,0 +1,83 @@
+"""Collapse of a dry Drucker-Prager column on moving particles: how far each nodal rule gets.
+
+The set-up of Bui et al. (2008): a column 0.2 m long and 0.1 m high against a smooth wall at
+x = 0, released at t = 0 onto a floor with Coulomb friction; E = 0.84 MPa, nu = 0.3,
+rho = 2650 kg/m^3, phi = 19.8 deg, c = 0, psi = 0; geostatic start with K0 = 1 - sin(phi).
+``rkfx.models.lagrangian_plasticity`` on a grid of ``nx`` particles across, a = 2 h,
+central differences at ``cfl`` h / c. Prints the state every tenth of the run and a last line
+with the run-out, the height at the wall, how long the run went and why it stopped.
+
+    python bench/column_collapse.py [--nx 21] [--rule nsni] [--t-end 0.7] [--viscosity 0]
+        [--cfl 0.3] [--floor-friction 0.36]
+"""
+import argparse
+import time
+
+import numpy as np
+
+from rkfx.assembly.rigid_walls import Wall
+from rkfx.errors import InputError
+from rkfx.geometry.nodal_domains import nodal_domains
+from rkfx.geometry.particles import structured
+from rkfx.materials.drucker_prager import DruckerPrager
+from rkfx.models.lagrangian_plasticity import LagrangianPlasticity
+from rkfx.solvers.central_difference import CentralDifference
+
+
+class _Printer:
+    def __init__(self, model, t0):
+        self.model, self.t0 = model, t0
+
+    def record(self, s):
+        m = self.model
+        print(f"t={s.time:.3f} s  front={m.x[:, 0].max():.4f} m  height at wall={m.x[m.x[:, 0] < 0.01, 1].max():.4f} m  "
+              f"kinetic={s.energies()['kinetic']:.3e} J  max eps_p={m.plastic_strain.max():.2f}  "
+              f"wall time={time.perf_counter() - self.t0:.1f} s", flush=True)
+
+    def arrays(self):
+        return {}
+
+    def restore(self, arrays):
+        pass
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--nx", type=int, default=21)
+    ap.add_argument("--rule", default="nsni")
+    ap.add_argument("--t-end", type=float, default=0.7)
+    ap.add_argument("--viscosity", type=float, default=0.0)
+    ap.add_argument("--cfl", type=float, default=0.3)
+    ap.add_argument("--floor-friction", type=float, default=float(np.tan(np.radians(19.8))))
+    args = ap.parse_args()
+    width, height = 0.2, 0.1
+    h = width / (args.nx - 1)
+    p = structured(width, height, args.nx, int(round(height / h)) + 1)
+    soil = DruckerPrager(E=0.84e6, nu=0.3, phi=19.8, c=0.0, psi=0.0)
+    rho, g = 2650.0, 9.81
+    k0 = 1.0 - np.sin(np.radians(soil.phi))
+    sy = -rho * g * (height - p.x[:, 1])
+    stress = np.column_stack([k0 * sy, sy, k0 * sy, 0.0 * sy])
+    c = np.sqrt((soil.bulk_modulus + 4.0 * soil.shear_modulus / 3.0) / rho)
+    dt = args.cfl * h / c
+    walls = [Wall((0, 0), (0, 1), args.floor_friction, "floor"), Wall((0, 0), (1, 0), 0.0, "wall")]
+    model = LagrangianPlasticity(p.x, nodal_domains(p).area, 2.0 * h, p.boundary_edges, soil, rho, dt, rule=args.rule,
+                                 walls=walls, stress=stress, gravity=(0.0, -g), viscosity=args.viscosity)
+    steps = int(np.ceil(args.t_end / dt))
+    print(f"{len(p.x)} particles, h = {h:.4g} m, dt = {dt:.3g} s, {steps} steps, rule {args.rule}, "
+          f"viscosity {args.viscosity}", flush=True)
+    t0 = time.perf_counter()
+    why = "ran to t_end"
+    try:
+        CentralDifference(dt).run(model, steps, output_every=max(1, steps // 10), recorder=_Printer(model, t0))
+    except InputError as e:
+        why = f"stopped: {e}"
+    wall = time.perf_counter() - t0
+    done = model.neighbour_rebuilds["steps"]
+    print(f"run-out {model.x[:, 0].max():.4f} m (dL/L = {(model.x[:, 0].max() - width) / width:.3f}), "
+          f"height at the wall {model.x[model.x[:, 0] < 0.01, 1].max():.4f} m, t = {done * dt:.3f} s after {done} "
+          f"steps, {1e3 * wall / max(done, 1):.1f} ms/step; {model.neighbour_rebuilds}; {why}")
+
+
+if __name__ == "__main__":
+    main()
