@@ -1,18 +1,25 @@
 """The boundary conditions of ``rkfx.conditions`` on dolfinx meshes: what the FEM baselines share.
 
 A condition's part (:data:`Part`) is resolved to local facets by :class:`BoundaryParts`: the name
-of a gmsh physical group (when the mesh came from gmsh with facet tags), a side of the mesh's
-bounding box (``"left"``, ``"right"``, ``"bottom"``, ``"top"``, located by coordinates), an int
-facet tag, or a marker ``marker(x) -> bool (m,)`` with x of shape ``(m, gdim)`` (dolfinx's
-``X`` of shape ``(3, m)`` is passed as ``X[:gdim].T``; a facet belongs to the part when the marker
-holds at all its vertices).
+of a gmsh physical group (when the mesh came from gmsh with facet tags, e.g. by
+``fem_baselines.gmsh_mesh.mesh_from_gmsh``), a side of the mesh's bounding box (located by
+coordinates: ``"left"``, ``"right"``, ``"bottom"``, ``"top"`` in 2-D (:data:`SIDES`);
+``"left"``/``"right"`` (x), ``"front"``/``"back"`` (y), ``"bottom"``/``"top"`` (z) in 3-D
+(:data:`SIDES_3D`, the names of ``rkfx.geometry.gmsh_solids.box``)), an int facet tag, or a
+marker ``marker(x) -> bool (m,)`` with x of shape ``(m, gdim)`` (dolfinx's ``X`` of shape
+``(3, m)`` is passed as ``X[:gdim].T``; a facet belongs to the part when the marker holds at all
+its vertices). Facets are edges of triangles or quadrilaterals in 2-D and triangles of tetrahedra
+in 3-D.
 
 Values are evaluated by ``rkfx.conditions.values`` at dolfinx's interpolation points and
 returned in dolfinx's layout (:func:`at_points`); tractions and fluxes given as ``value(x, t, n)``
-get n, the outward unit normal of the part's facet nearest to each point (by facet midpoint:
-exact for the Lagrange points on the facets up to degree 3). The data is continuous: at a
-vertex where one part turns a corner it takes one facet's normal, so give each side of a corner
-its own condition. Data of a part is interpolated on the cells next to its facets only
+get n, the outward unit normal of the part's facet nearest to each point (by facet midpoint,
+the centroid of a triangle in 3-D: in 2-D exact for the Lagrange points on the facets up to
+degree 3; on a flat part in 3-D every facet has the part's normal, and on a curved one -- the
+``surface`` of a sphere -- a point on a facet's edge may take the normal of the facet next to
+it, a difference of the order of the facets' angle). The data is continuous: at a vertex where
+one part turns a corner it takes one facet's normal, so give each side of a corner its own
+condition. Data of a part is interpolated on the cells next to its facets only
 (:meth:`BoundaryParts.interpolate`): those carry every dof that a ``ds`` integral or a Dirichlet
 condition on the part reads.
 
@@ -39,14 +46,24 @@ import dolfinx.mesh
 from rkfx.conditions import NATURAL, Condition, Region, split, values
 from rkfx.errors import InputError
 
-__all__ = ["SIDES", "BoundaryParts", "Part", "at_points", "check_kinds"]
+__all__ = ["SIDES", "SIDES_3D", "BoundaryParts", "Part", "at_points", "check_kinds", "sides"]
 
 #: A boundary part: a physical-group name or a side of the bounding box (str), a facet tag
 #: (int), or a marker ``marker(x) -> bool (m,)`` with x of shape (m, gdim).
 Part = str | int | Callable[[np.ndarray], np.ndarray]
 
-#: The sides of a mesh's bounding box that name parts without facet tags: (axis, lower side?).
+#: The sides of a 2-D mesh's bounding box that name parts without facet tags: (axis, lower side?).
 SIDES = {"left": (0, True), "right": (0, False), "bottom": (1, True), "top": (1, False)}
+
+#: The sides of a 3-D mesh's bounding box, named as ``rkfx.geometry.gmsh_solids.box`` names the
+#: faces of a box (z is up): (axis, lower side?).
+SIDES_3D = {"left": (0, True), "right": (0, False), "front": (1, True), "back": (1, False),
+            "bottom": (2, True), "top": (2, False)}
+
+
+def sides(gdim: int) -> dict[str, tuple[int, bool]]:
+    """The bounding-box sides that name parts on a mesh of geometric dimension ``gdim``."""
+    return SIDES_3D if gdim == 3 else SIDES
 
 
 def _describe(part: Any) -> str:
@@ -71,7 +88,7 @@ def check_kinds(conditions: Sequence[Condition], allowed: tuple[type, ...], solv
             raise InputError(f"{solver} takes no {kind.__name__} conditions (on {_describe(found[0].boundary)}); "
                              f"give {names} from rkfx.conditions")
         for c in found:
-            if max(c.components) >= gdim:
+            if max(c.prescribed(gdim)) >= gdim:
                 raise InputError(f"{kind.__name__} on {_describe(c.boundary)}: components {c.components} on a "
                                  f"{gdim}D mesh; use components below {gdim}")
     return kinds
@@ -94,24 +111,39 @@ def at_points(condition: Condition, X: np.ndarray, t: float, gdim: int, n: np.nd
         Shape (npts,) for a scalar field, (k, npts) for a vector field.
     """
     npts = X.shape[1]
-    v = values(condition, X[:gdim].T, t, n) if npts else np.zeros((0, len(condition.components)))
+    components = list(condition.prescribed(gdim))
+    v = values(condition, X[:gdim].T, t, n) if npts else np.zeros((0, len(components)))
     if not shape:
         return np.ascontiguousarray(v[:, 0])
     out = np.zeros((shape[0], npts))
-    out[list(condition.components)] = v.T
+    out[components] = v.T
     return out
 
 
 def _outward_normals(mesh: dolfinx.mesh.Mesh, facets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Midpoints and outward unit normals, both (nf, 2), of exterior facets of a 2D mesh."""
-    fdim, x = mesh.topology.dim - 1, mesh.geometry.x
-    ends = dolfinx.mesh.entities_to_geometry(mesh, fdim, facets)[:, :2]  # the facets' vertices come first
-    a, b = x[ends[:, 0], :2], x[ends[:, 1], :2]
-    mid, tangent = 0.5 * (a + b), b - a
-    normal = np.column_stack([tangent[:, 1], -tangent[:, 0]]) / np.linalg.norm(tangent, axis=1)[:, None]
+    """Midpoints and outward unit normals, both (nf, gdim), of exterior facets of a 2D or 3D mesh.
+
+    A 2-D facet is a segment (normal: the tangent turned by 90 degrees), a 3-D facet a triangle
+    (normal: the cross product of two edges; its midpoint is the centroid). Either normal is
+    turned away from the centre of the facet's one cell.
+    """
+    fdim, x, gdim = mesh.topology.dim - 1, mesh.geometry.x, mesh.geometry.dim
+    corners = dolfinx.mesh.entities_to_geometry(mesh, fdim, facets)[:, :gdim]  # the facets' vertices come first
+    if gdim == 2:
+        a, b = x[corners[:, 0], :2], x[corners[:, 1], :2]
+        mid, tangent = 0.5 * (a + b), b - a
+        normal = np.column_stack([tangent[:, 1], -tangent[:, 0]]) / np.linalg.norm(tangent, axis=1)[:, None]
+    else:
+        # The corners in lexicographic order of their coordinates, not the local numbering: a facet
+        # shared by two ranks then gets bit-identical midpoint and normal on both.
+        p = x[corners]  # (nf, 3, 3)
+        order = np.lexsort((p[:, :, 2], p[:, :, 1], p[:, :, 0]), axis=1)
+        a, b, c = (np.take_along_axis(p, order[:, i, None, None], axis=1)[:, 0] for i in range(3))
+        mid, normal = (a + b + c) / 3.0, np.cross(b - a, c - a)
+        normal /= np.maximum(np.linalg.norm(normal, axis=1), np.finfo(float).tiny)[:, None]
     f2c = mesh.topology.connectivity(fdim, mesh.topology.dim)
     cells = np.asarray(f2c.array)[np.asarray(f2c.offsets)[facets]]  # the one cell of an exterior facet
-    centre = x[dolfinx.mesh.entities_to_geometry(mesh, mesh.topology.dim, cells), :2].mean(axis=1)
+    centre = x[dolfinx.mesh.entities_to_geometry(mesh, mesh.topology.dim, cells), :gdim].mean(axis=1)
     normal[np.einsum("ij,ij->i", normal, mid - centre) < 0] *= -1.0
     return mid, normal
 
@@ -160,11 +192,12 @@ class BoundaryParts:
                     raise InputError(f"boundary part {part!r} is a physical group of dimension {dim}; name one "
                                      f"of dimension {fdim} (facets)")
                 return self._tagged(part, tag)
-            if part in SIDES:
+            if part in sides(self.gdim):
                 return dolfinx.mesh.locate_entities_boundary(mesh, fdim, self._side(part))
             groups = sorted(n for n, (d, _) in self.physical_groups.items() if d == fdim)
             raise InputError(f"no boundary part {part!r}: name a physical group {groups}, a side of the bounding "
-                             f"box {list(SIDES)}, or give a marker x -> bool with x of shape (m, {self.gdim})")
+                             f"box {list(sides(self.gdim))}, or give a marker x -> bool with x of shape "
+                             f"(m, {self.gdim})")
         if isinstance(part, (int, np.integer)) and not isinstance(part, bool):
             return self._tagged(part, int(part))
         if isinstance(part, Region):
@@ -203,7 +236,7 @@ class BoundaryParts:
             self._box = lo, hi
         lo, hi = self._box
         tol = 1e-10 * float(np.max(hi - lo))
-        axis, lower = SIDES[side]
+        axis, lower = sides(self.gdim)[side]
         value = lo[axis] if lower else hi[axis]
         return lambda X: np.abs(X[axis] - value) <= tol
 
@@ -231,27 +264,45 @@ class BoundaryParts:
     # ------------------------------------------------------------------ data
 
     def normals(self, part: Part, x: np.ndarray) -> np.ndarray:
-        """Outward unit normal of the part's facet (by midpoint) nearest to each point x (m, gdim)."""
-        if self.gdim != 2 or self.mesh.topology.dim != 2:
-            raise InputError(f"boundary part {_describe(part)}: normals need a 2D mesh; give a constant value")
-        key = (type(part).__name__, part) if not callable(part) else part
-        if key not in self._normals:
-            mid, normal = _outward_normals(self.mesh, self.facets(part))
-            self._normals[key] = (cKDTree(mid) if len(mid) else None, normal)
-        tree, normal = self._normals[key]
+        """Outward unit normal of the part's facet (by midpoint) nearest to each point x (m, gdim).
+
+        Collective on first use of a part when the mesh is distributed: every rank then looks
+        among the facets of all ranks, so that a point gets the same normal however the mesh is
+        split (on a curved part the nearest local facet would depend on the partition).
+        """
+        tree, normal = self._normal_table(part)
         if tree is None:
             return np.full((len(x), self.gdim), np.nan)
         return normal[tree.query(x)[1]]
+
+    def _normal_table(self, part: Part) -> tuple[cKDTree | None, np.ndarray]:
+        """The part's facet midpoints (as a k-d tree) and outward normals, built once per part."""
+        if self.gdim != self.mesh.topology.dim or self.gdim not in (2, 3):
+            raise InputError(f"boundary part {_describe(part)}: normals need a 2D or 3D mesh of cells of its own "
+                             "dimension; give a constant value")
+        key = (type(part).__name__, part) if not callable(part) else part
+        if key not in self._normals:
+            mid, normal = _outward_normals(self.mesh, self.facets(part))
+            comm = self.mesh.comm
+            if comm.size > 1:  # all ranks' facets, each once (shared ones computed bit-identically), sorted
+                table = np.concatenate(comm.allgather(np.column_stack([mid, normal])))
+                table = np.unique(table, axis=0)
+                mid, normal = table[:, : self.gdim], table[:, self.gdim:]
+            self._normals[key] = (cKDTree(mid) if len(mid) else None, normal)
+        return self._normals[key]
 
     def interpolate(self, fn: dolfinx.fem.Function, condition: Condition, t: float) -> None:
         """fn = the condition's value at t on the cells next to its part (the other dofs are left alone).
 
         Tractions and fluxes given as ``value(x, t, n)`` get the outward normals of
-        :meth:`normals`; a scalar fn takes the first prescribed component.
+        :meth:`normals`; a scalar fn takes the first prescribed component. Collective on the
+        mesh communicator.
         """
         shape = tuple(fn.function_space.value_shape)
         part, gdim = condition.boundary, self.gdim
         want_n = isinstance(condition, NATURAL) and callable(condition.value)
+        if want_n:
+            self._normal_table(part)  # collective: before dolfinx calls data() on the ranks that have points
 
         def data(X):
             n = self.normals(part, X[:gdim].T) if want_n and X.shape[1] else None

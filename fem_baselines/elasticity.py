@@ -1,18 +1,23 @@
-"""Plane-strain linear elasticity with dolfinx: the FEM baseline for RKPM runs.
+"""Linear elasticity with dolfinx, plane strain (2-D) and 3-D: the FEM baseline for RKPM runs.
 
-The geometry is the one the RKPM solvers use: a 2D gmsh model with one 2D
-physical group for the domain and 1D physical groups naming boundary parts.
-The model is converted with :func:`dolfinx.io.gmsh.model_to_mesh` (read on
-rank 0, distributed over ``comm``), then the problem
+The geometry is the one the RKPM solvers use: a gmsh model with one physical group
+of the top dimension for the domain and groups one dimension lower naming boundary
+parts -- a 2D model of triangles, or a 3D solid of tetrahedra from
+``rkfx.geometry.gmsh_solids``. The model is converted with
+:func:`dolfinx.io.gmsh.model_to_mesh` (read on rank 0, distributed over ``comm``;
+``fem_baselines.gmsh_mesh``), then the problem
 
     -div sigma(u) = f   in Omega,
     u_c = g_c           on Gamma_D (the listed components c),
     sigma(u) n = t      on Gamma_N,
 
-is solved with vector Lagrange P``degree`` elements on triangles and a direct
-MUMPS LU factorisation, with the plane-strain constitutive law
-``sigma = lambda tr(eps) I + 2 mu eps``, lambda and mu from
-:class:`rkfx.materials.elasticity.ElasticMaterial` (the law of the RKPM solvers).
+is solved with vector Lagrange P``degree`` elements on triangles
+(:func:`solve_plane_strain`) or tetrahedra (:func:`solve_elasticity_3d`) and a
+direct MUMPS LU factorisation, with the law ``sigma = lambda tr(eps) I + 2 mu eps``:
+in 2-D lambda and mu of the plane-strain law of
+:class:`rkfx.materials.elasticity.ElasticMaterial` (the law of the RKPM solvers),
+in 3-D the Lame constants of the same isotropic solid (:func:`stress_law`).
+:func:`errors` measures L2, H1 and energy errors against an exact displacement.
 
 Boundary conditions are ``Displacement`` and ``Traction`` of ``rkfx.conditions``,
 the RKPM solvers' vocabulary; ``fem_baselines.conditions`` resolves their parts
@@ -48,20 +53,22 @@ import dolfinx.mesh
 import ufl
 
 from fem_baselines.conditions import BoundaryParts, check_kinds
+from fem_baselines.gmsh_mesh import mesh_from_gmsh, mesh_parts
 from rkfx.conditions import Condition, Displacement, Traction
 from rkfx.materials.elasticity import ElasticMaterial
 
 __all__ = [
     "FemElasticityResult",
     "errors",
+    "solve_elasticity_3d",
     "solve_plane_strain",
     "strain",
     "stress_law",
 ]
 
-#: A vector field given as a callable ``g(x)``, ``x`` of shape (2, npts),
-#: returning shape (2, npts) (or (2,) for a constant), or as a constant
-#: array-like of shape (2,).
+#: A vector field given as a callable ``g(x)``, ``x`` of shape (gdim, npts),
+#: returning shape (gdim, npts) (or (gdim,) for a constant), or as a constant
+#: array-like of shape (gdim,).
 VectorData = Callable[[np.ndarray], np.ndarray] | Any
 
 _prefix_counter = itertools.count()
@@ -79,37 +86,50 @@ def strain(w):
     return ufl.sym(ufl.grad(w))
 
 
-def stress_law(mesh: dolfinx.mesh.Mesh, material: ElasticMaterial) -> Callable:
-    """The 2-D law ``sigma(w) = lambda tr(eps(w)) I + 2 mu eps(w)`` of ``material`` in UFL.
-
-    lambda and mu are :attr:`rkfx.materials.elasticity.ElasticMaterial.lame` (plane strain or plane
-    stress), as dolfinx Constants on ``mesh``: forms built with other values share one
-    compiled kernel.
-
-    Returns:
-        ``sigma(w)``: the stress tensor (2 x 2 UFL expression) of a vector field ``w`` [Pa].
-    """
+def _law_of_strain(mesh: dolfinx.mesh.Mesh, material: ElasticMaterial) -> Callable:
+    """``sigma(eps) = lambda tr(eps) I + 2 mu eps`` of a UFL strain, as :func:`stress_law` sets it up."""
     scalar = dolfinx.default_scalar_type
-    lam_v, mu_v = material.lame
+    gdim = mesh.geometry.dim
+    # 2-D: the plane law (plane strain or plane stress); 3-D: the solid's own Lame constants.
+    lam_v, mu_v = material.lame if gdim == 2 else (material.lame_lambda, material.shear_modulus)
     lam = dolfinx.fem.Constant(mesh, scalar(lam_v))
     mu = dolfinx.fem.Constant(mesh, scalar(mu_v))
 
+    def law(eps):
+        return lam * ufl.tr(eps) * ufl.Identity(gdim) + 2.0 * mu * eps
+
+    return law
+
+
+def stress_law(mesh: dolfinx.mesh.Mesh, material: ElasticMaterial) -> Callable:
+    """The law ``sigma(w) = lambda tr(eps(w)) I + 2 mu eps(w)`` of ``material`` in UFL.
+
+    On a 2-D mesh lambda and mu are :attr:`rkfx.materials.elasticity.ElasticMaterial.lame`
+    (plane strain or plane stress); on a 3-D mesh they are the Lame constants of the isotropic
+    solid, ``material.lame_lambda`` and ``material.shear_modulus`` (``material.plane`` plays no
+    part). They are dolfinx Constants on ``mesh``: forms built with other values share one
+    compiled kernel.
+
+    Returns:
+        ``sigma(w)``: the stress tensor (gdim x gdim UFL expression) of a vector field ``w`` [Pa].
+    """
+    law = _law_of_strain(mesh, material)
+
     def sigma(w):
-        eps = strain(w)
-        return lam * ufl.tr(eps) * ufl.Identity(2) + 2.0 * mu * eps
+        return law(strain(w))
 
     return sigma
 
 
 @dataclass
 class FemElasticityResult:
-    """Solution of a plane-strain FEM baseline.
+    """Solution of an elastic FEM baseline (plane strain or 3-D).
 
     Attributes:
-        mesh: The distributed dolfinx mesh (triangles, gdim 2).
+        mesh: The distributed dolfinx mesh (triangles, gdim 2, or tetrahedra, gdim 3).
         u: Displacement, a dolfinx vector P``degree`` Function on ``mesh``
             (ghost values up to date).
-        n_dofs: Global number of scalar degrees of freedom (2 per node).
+        n_dofs: Global number of scalar degrees of freedom (gdim per node).
         wall_time_s: Wall-clock seconds of the whole call (mesh conversion,
             setup incl. form JIT, assembly and solve), max over ranks.
         degree: Polynomial degree of the elements.
@@ -120,6 +140,8 @@ class FemElasticityResult:
         facet_tags: Facet MeshTags from gmsh, or None.
         physical_groups: Physical-group name -> (dim, tag) from gmsh
             (empty for a bare mesh).
+        material: The elastic solid (for the energy norm of :func:`errors`),
+            or None.
     """
 
     mesh: dolfinx.mesh.Mesh
@@ -130,6 +152,7 @@ class FemElasticityResult:
     timings: dict[str, float] = field(default_factory=dict)
     facet_tags: Any = None
     physical_groups: dict[str, Any] = field(default_factory=dict)
+    material: ElasticMaterial | None = None
     _tree: Any = field(default=None, init=False, repr=False)
 
     @property
@@ -145,20 +168,22 @@ class FemElasticityResult:
         takes the value of the lowest such rank.
 
         Args:
-            points: Coordinates, shape (npts, 2) (a single point of shape (2,)
-                is accepted), in mesh length units.
+            points: Coordinates, shape (npts, gdim) (a single point of shape
+                (gdim,) is accepted; in 2-D also (npts, 3) with z ignored), in
+                mesh length units.
 
         Returns:
-            Displacements, shape (npts, 2); rows of points lying in no cell of
-            the mesh are NaN.
+            Displacements, shape (npts, gdim); rows of points lying in no cell
+            of the mesh are NaN.
         """
+        gdim = self.mesh.geometry.dim
         pts = np.atleast_2d(np.asarray(points, dtype=np.float64))
-        if pts.ndim != 2 or pts.shape[1] not in (2, 3):
-            raise ValueError(f"points must have shape (npts, 2), got {np.shape(points)}")
+        if pts.ndim != 2 or pts.shape[1] not in (gdim, 3):
+            raise ValueError(f"points must have shape (npts, {gdim}), got {np.shape(points)}")
         npts = pts.shape[0]
         x3 = np.zeros((npts, 3), dtype=self.mesh.geometry.x.dtype)
         x3[:, : pts.shape[1]] = pts
-        x3[:, 2] = 0.0
+        x3[:, gdim:] = 0.0
 
         tdim = self.mesh.topology.dim
         if self._tree is None:
@@ -175,43 +200,44 @@ class FemElasticityResult:
             comm.Allreduce(MPI.IN_PLACE, owner, op=MPI.MIN)
         mine = owner == rank
 
-        values = np.zeros((npts, 2), dtype=np.float64)
+        values = np.zeros((npts, gdim), dtype=np.float64)
         if np.any(mine):
             cells = np.asarray(colliding.array)[offsets[:-1][mine]]
-            values[mine] = self.u.eval(x3[mine], cells).reshape(-1, 2)
+            values[mine] = self.u.eval(x3[mine], cells).reshape(-1, gdim)
         if size > 1:
             comm.Allreduce(MPI.IN_PLACE, values, op=MPI.SUM)
         values[owner == size] = np.nan
         return values
 
 
-def _vector_values(data: VectorData, x: np.ndarray) -> np.ndarray:
+def _vector_values(data: VectorData, x: np.ndarray, gdim: int = 2) -> np.ndarray:
     """Evaluate vector data at dolfinx interpolation points.
 
     Args:
-        data: Callable of x (2, npts) or constant array-like of shape (2,).
+        data: Callable of x (gdim, npts) or constant array-like of shape (gdim,).
         x: Interpolation points from dolfinx, shape (3, npts).
+        gdim: Geometric dimension (components of the field, rows of x passed on).
 
     Returns:
-        Array of shape (2, npts).
+        Array of shape (gdim, npts).
     """
     npts = x.shape[1]
-    val = np.asarray(data(x[:2]) if callable(data) else data, dtype=np.float64)
-    if val.shape == (2,):
+    val = np.asarray(data(x[:gdim]) if callable(data) else data, dtype=np.float64)
+    if val.shape == (gdim,):
         val = val[:, None]
-    return np.ascontiguousarray(np.broadcast_to(val, (2, npts)))
+    try:
+        return np.ascontiguousarray(np.broadcast_to(val, (gdim, npts)))
+    except ValueError:
+        raise ValueError(f"body_force gave shape {val.shape} for {npts} points; return ({gdim}, npts) for x of "
+                         f"shape ({gdim}, npts), or give a constant of shape ({gdim},)") from None
 
 
-def _to_mesh_data(model_or_mesh: Any, comm: MPI.Comm):
+def _to_mesh_data(model_or_mesh: Any, comm: MPI.Comm, gdim: int = 2):
     """Normalise the geometry argument to (mesh, facet_tags, physical_groups)."""
-    if isinstance(model_or_mesh, dolfinx.io.gmsh.MeshData):
-        md = model_or_mesh
-        return md.mesh, md.facet_tags, dict(md.physical_groups)
-    if isinstance(model_or_mesh, dolfinx.mesh.Mesh):
-        return model_or_mesh, None, {}
+    if isinstance(model_or_mesh, (dolfinx.io.gmsh.MeshData, dolfinx.mesh.Mesh)):
+        return mesh_parts(model_or_mesh)
     # A gmsh model (the ``gmsh.model`` module object); only rank 0 reads it.
-    md = dolfinx.io.gmsh.model_to_mesh(model_or_mesh, comm, 0, gdim=2)
-    return md.mesh, md.facet_tags, dict(md.physical_groups)
+    return mesh_parts(mesh_from_gmsh(model_or_mesh, comm, gdim))
 
 
 def solve_plane_strain(
@@ -264,45 +290,108 @@ def solve_plane_strain(
         on the cells next to its part. E and nu enter the forms as dolfinx
         Constants, so changing them does not trigger a new form compilation.
     """
+    return _solve(model_or_mesh, E, nu, conditions, body_force, degree, comm, gdim=2, name="solve_plane_strain")
+
+
+def solve_elasticity_3d(
+    model_or_mesh: Any,
+    E: float,
+    nu: float,
+    conditions: Sequence[Condition],
+    degree: int = 1,
+    body_force: VectorData | None = None,
+    comm: MPI.Comm | None = None,
+) -> FemElasticityResult:
+    """Solve 3-D linear elasticity with vector Lagrange elements on tetrahedra.
+
+    Collective on ``comm``. The law is sigma = lambda tr(eps) I + 2 mu eps with the Lame
+    constants of the isotropic solid (E, nu). Everything else is as in
+    :func:`solve_plane_strain`, one dimension up.
+
+    Args:
+        model_or_mesh: The geometry: a ``gmsh.model`` meshed in 3-D with tetrahedra, a 3-D
+            physical group for the solid and 2-D groups naming boundary parts (e.g. built by
+            ``rkfx.geometry.gmsh_solids``; only rank 0 needs it); or its ``MeshData`` from
+            ``fem_baselines.gmsh_mesh.mesh_from_gmsh`` / ``build_mesh``; or a bare tetrahedral
+            :class:`dolfinx.mesh.Mesh` (parts are then the sides ``left``/``right``,
+            ``front``/``back``, ``bottom``/``top`` of its bounding box, or markers).
+        E: Young's modulus [Pa].
+        nu: Poisson's ratio [-] (< 0.5).
+        conditions: ``Displacement`` (the listed components among 0, 1, 2; one component is a
+            roller) and ``Traction`` of ``rkfx.conditions``, evaluated at t = 0; x and the
+            outward unit normals n of shape (m, 3) [m]. Traction parts must be disjoint.
+            Boundaries without conditions are traction-free.
+        degree: Polynomial degree of the displacement elements (1: P1, 2: P2, ...).
+        body_force: Body force per unit volume ``f(x)`` [N/m^3], x of shape (3, npts),
+            returning shape (3, npts), or a constant of shape (3,); None for none.
+        comm: MPI communicator; defaults to ``MPI.COMM_WORLD``. Ignored for an already-built
+            mesh (its communicator is used).
+
+    Returns:
+        The solution; see :class:`FemElasticityResult` (``u`` of 3 components, ``evaluate``
+        at points (npts, 3), ``material`` set for the energy norm of :func:`errors`).
+    """
+    return _solve(model_or_mesh, E, nu, conditions, body_force, degree, comm, gdim=3, name="solve_elasticity_3d")
+
+
+#: The cells each solver takes.
+_CELLS = {2: (dolfinx.mesh.CellType.triangle, "a 2D triangle mesh (gdim 2)"),
+          3: (dolfinx.mesh.CellType.tetrahedron, "a 3D tetrahedral mesh (gdim 3)")}
+
+
+def _solve(model_or_mesh: Any, E: float, nu: float, conditions: Sequence[Condition], body_force: VectorData | None,
+           degree: int, comm: MPI.Comm | None, gdim: int, name: str) -> FemElasticityResult:
+    """The elastic solve of :func:`solve_plane_strain` (gdim 2) and :func:`solve_elasticity_3d` (gdim 3)."""
     if degree < 1:
         raise ValueError(f"degree must be >= 1, got {degree}")
     comm = MPI.COMM_WORLD if comm is None else comm
     t_start = time.perf_counter()
 
-    mesh, facet_tags, physical_groups = _to_mesh_data(model_or_mesh, comm)
+    mesh, facet_tags, physical_groups = _to_mesh_data(model_or_mesh, comm, gdim)
     comm = mesh.comm
-    if mesh.geometry.dim != 2 or mesh.topology.cell_type != dolfinx.mesh.CellType.triangle:
-        raise ValueError("solve_plane_strain expects a 2D triangle mesh (gdim 2)")
+    cell, what = _CELLS[gdim]
+    if mesh.geometry.dim != gdim or mesh.topology.cell_type != cell:
+        raise ValueError(f"{name} expects {what}")
     tdim = mesh.topology.dim
     fdim = tdim - 1
     mesh.topology.create_connectivity(fdim, tdim)
     t_mesh = time.perf_counter()
 
-    V = dolfinx.fem.functionspace(mesh, ("Lagrange", degree, (2,)))
-    W = dolfinx.fem.functionspace(mesh, ("Lagrange", degree + 1, (2,)))
+    V = dolfinx.fem.functionspace(mesh, ("Lagrange", degree, (gdim,)))
+    W = dolfinx.fem.functionspace(mesh, ("Lagrange", degree + 1, (gdim,)))
     scalar = dolfinx.default_scalar_type
 
     # Dirichlet conditions: all components on V, one component (a roller) on its subspace.
-    kinds = check_kinds(conditions, (Displacement, Traction), "solve_plane_strain", gdim=2)
+    kinds = check_kinds(conditions, (Displacement, Traction), name, gdim=gdim)
     parts = BoundaryParts(mesh, facet_tags, physical_groups)
     bcs = []
     for c in kinds[Displacement]:
         facets = parts.facets(c.boundary)
-        if len(c.components) == 1:
-            comp = c.components[0]
+        components = c.prescribed(gdim)
+        if len(components) == 1:
+            comp = components[0]
             Vc, _ = V.sub(comp).collapse()
             gc = dolfinx.fem.Function(Vc)
             parts.interpolate(gc, c, 0.0)
             dofs = dolfinx.fem.locate_dofs_topological((V.sub(comp), Vc), fdim, facets)
             bcs.append(dolfinx.fem.dirichletbc(gc, dofs, V.sub(comp)))
-        else:
+        else:  # the unlisted components of the value are 0 on V and are not prescribed
             gv = dolfinx.fem.Function(V)
             parts.interpolate(gv, c, 0.0)
-            dofs = dolfinx.fem.locate_dofs_topological(V, fdim, facets)
-            bcs.append(dolfinx.fem.dirichletbc(gv, dofs))
+            if len(components) == gdim:
+                dofs = dolfinx.fem.locate_dofs_topological(V, fdim, facets)
+                bcs.append(dolfinx.fem.dirichletbc(gv, dofs))
+            else:  # two components of three: each a roller with its part of gv
+                for comp in components:
+                    Vc, to_parent = V.sub(comp).collapse()
+                    gc = dolfinx.fem.Function(Vc)
+                    gc.x.array[:] = gv.x.array[to_parent]
+                    dofs = dolfinx.fem.locate_dofs_topological((V.sub(comp), Vc), fdim, facets)
+                    bcs.append(dolfinx.fem.dirichletbc(gc, dofs, V.sub(comp)))
 
     # Constitutive law (Constants: no recompilation for new E, nu).
-    sigma = stress_law(mesh, ElasticMaterial(E, nu))
+    material = ElasticMaterial(E, nu)
+    sigma = stress_law(mesh, material)
 
     u = ufl.TrialFunction(V)
     v = ufl.TestFunction(V)
@@ -311,7 +400,7 @@ def solve_plane_strain(
     rhs = []
     if body_force is not None:
         f = dolfinx.fem.Function(W, name="body_force")
-        f.interpolate(lambda x: _vector_values(body_force, x))
+        f.interpolate(lambda x: _vector_values(body_force, x, gdim))
         rhs.append(ufl.inner(f, v) * ufl.dx)
     if kinds[Traction]:
         tags = parts.tags([c.boundary for c in kinds[Traction]], "traction")
@@ -323,7 +412,7 @@ def solve_plane_strain(
     if rhs:
         L = sum(rhs[1:], rhs[0])
     else:
-        L = ufl.inner(dolfinx.fem.Constant(mesh, np.zeros(2, dtype=scalar)), v) * ufl.dx
+        L = ufl.inner(dolfinx.fem.Constant(mesh, np.zeros(gdim, dtype=scalar)), v) * ufl.dx
 
     uh = dolfinx.fem.Function(V, name="u")
     problem = dolfinx.fem.petsc.LinearProblem(
@@ -355,18 +444,21 @@ def solve_plane_strain(
         timings={"mesh": float(glob[0]), "setup": float(glob[1]), "solve": float(glob[2])},
         facet_tags=facet_tags,
         physical_groups=physical_groups,
+        material=material,
     )
 
 
 def _max_cell_diameter(mesh: dolfinx.mesh.Mesh) -> float:
-    """Largest edge length over owned cells (vertex-based), global max."""
-    ncells = mesh.topology.index_map(mesh.topology.dim).size_local
-    x = mesh.geometry.x[:, :2]
-    conn = mesh.geometry.dofmaps[0][:ncells, :3]
+    """Largest edge length over owned simplices (vertex-based), global max."""
+    tdim, gdim = mesh.topology.dim, mesh.geometry.dim
+    ncells = mesh.topology.index_map(tdim).size_local
+    x = mesh.geometry.x[:, :gdim]
+    conn = mesh.geometry.dofmaps[0][:ncells, : tdim + 1]  # a simplex's vertices come first
     h = 0.0
     if ncells:
-        p = x[conn]  # (ncells, 3, 2)
-        edges = p - np.roll(p, 1, axis=1)
+        p = x[conn]  # (ncells, tdim + 1, gdim)
+        i, j = np.triu_indices(tdim + 1, 1)  # every edge of the simplex
+        edges = p[:, i] - p[:, j]
         h = float(np.sqrt((edges**2).sum(axis=2)).max())
     return mesh.comm.allreduce(h, op=MPI.MAX)
 
@@ -376,26 +468,31 @@ def errors(
     u_exact: Callable[[Any], Any],
     grad_exact: Callable[[Any], Any] | None = None,
 ) -> dict[str, float]:
-    """Relative L2 and H1-seminorm errors against an exact solution.
+    """Relative L2, H1-seminorm and energy errors against an exact solution.
 
     Collective on the mesh communicator. Integrals use quadrature degree
     ``result.degree + 3``.
 
     Args:
-        result: A solution from :func:`solve_plane_strain`.
+        result: A solution from :func:`solve_plane_strain` or
+            :func:`solve_elasticity_3d`.
         u_exact: ``u_exact(X)`` takes ``X = ufl.SpatialCoordinate(mesh)`` and
-            returns a UFL vector expression of shape (2,) (a list/tuple of two
-            UFL scalars is accepted), e.g.
+            returns a UFL vector expression of shape (gdim,) (a list/tuple of
+            gdim UFL scalars is accepted), e.g.
             ``lambda X: ufl.as_vector((ufl.sin(ufl.pi * X[0]), X[1]))``.
-        grad_exact: ``grad_exact(X)`` returns the 2x2 UFL displacement
+        grad_exact: ``grad_exact(X)`` returns the gdim x gdim UFL displacement
             gradient, ``G[i, j] = d u_i / d x_j`` (nested lists accepted). If
             None, ``ufl.grad(u_exact(X))`` is used.
 
     Returns:
         Dict with ``"l2"`` = ||u_h - u|| / ||u||, ``"h1"`` =
         |u_h - u|_1 / |u|_1 (relative, dimensionless), the absolute values
-        ``"l2_abs"`` (length * length units) and ``"h1_abs"``, the exact
-        norms ``"l2_norm"``, ``"h1_norm"``, and ``"h_max"`` (largest cell edge).
+        ``"l2_abs"`` (length * length^(gdim/2) units) and ``"h1_abs"``, the
+        exact norms ``"l2_norm"``, ``"h1_norm"``, and ``"h_max"`` (largest cell
+        edge). When the result knows its material (both solvers set it), also
+        the energy error ``"energy"`` = ||u_h - u||_E / ||u||_E (relative) with
+        ||w||_E^2 = int sigma(w) : eps(w), and ``"energy_abs"`` [sqrt(J)],
+        ``"energy_norm"``.
     """
     mesh, uh = result.mesh, result.u
     X = ufl.SpatialCoordinate(mesh)
@@ -417,12 +514,17 @@ def errors(
         ufl.inner(eg, eg) * dx,
         ufl.inner(Ge, Ge) * dx,
     ]
+    if result.material is not None:
+        law = _law_of_strain(mesh, result.material)
+        for G in (eg, Ge):
+            eps = ufl.sym(G)
+            integrands.append(ufl.inner(law(eps), eps) * dx)
     vals = [
         mesh.comm.allreduce(dolfinx.fem.assemble_scalar(dolfinx.fem.form(F)), op=MPI.SUM)
         for F in integrands
     ]
-    e_l2, n_l2, e_h1, n_h1 = (float(np.sqrt(max(val, 0.0))) for val in vals)
-    return {
+    e_l2, n_l2, e_h1, n_h1, *energy = (float(np.sqrt(max(val, 0.0))) for val in vals)
+    out = {
         "l2": e_l2 / n_l2 if n_l2 > 0 else float("nan"),
         "h1": e_h1 / n_h1 if n_h1 > 0 else float("nan"),
         "l2_abs": e_l2,
@@ -431,3 +533,7 @@ def errors(
         "h1_norm": n_h1,
         "h_max": _max_cell_diameter(mesh),
     }
+    if energy:
+        e_en, n_en = energy
+        out.update({"energy": e_en / n_en if n_en > 0 else float("nan"), "energy_abs": e_en, "energy_norm": n_en})
+    return out

@@ -1,4 +1,4 @@
-"""Plane-strain linear Biot poroelasticity with dolfinx: the FEM baseline for the RKPM u-p solver.
+"""Linear Biot poroelasticity with dolfinx, plane strain and 3-D: the FEM baseline for the RKPM u-p solver.
 
 Governing equations (the seed's conventions, Wei 2018, ch. 3, eqs. 3.1-3.16; tensile effective
 stress positive, pore pressure compressive positive, no gravity):
@@ -6,8 +6,9 @@ stress positive, pore pressure compressive positive, no gravity):
     div(sigma''(u) - alpha p I) = 0,
     alpha div(du/dt) + S dp/dt - div(k grad p) = 0,
 
-with the drained plane-strain law ``sigma'' = lambda tr(eps) I + 2 mu eps`` (E, nu drained;
-``fem_baselines.elasticity.stress_law`` of ``rkfx.materials.elasticity.ElasticMaterial``),
+with the drained law ``sigma'' = lambda tr(eps) I + 2 mu eps`` (E, nu drained;
+``fem_baselines.elasticity.stress_law`` of ``rkfx.materials.elasticity.ElasticMaterial``: the
+plane-strain law on a 2-D mesh, the isotropic solid's on a 3-D one),
 Biot coefficient ``alpha``, storage coefficient ``S = 1/Q`` [1/Pa] (0 = incompressible
 constituents) and mobility ``k`` [m^2/(Pa s)] (permeability / viscosity, i.e. ``k_h/gamma_f``).
 
@@ -21,7 +22,8 @@ where ``S`` (only for ``element="q1q1-fpp"``) is the fluid-pressure-projection s
 White & Borja (2008) as the seed writes it in eqs. 3.49-3.52,
 ``S = int eps_f (psi - Pi psi)(p - Pi p)`` with ``Pi`` the cell-wise L2 projection onto constants
 and ``eps_f`` from eqs. 3.53-3.54 (``rkfx.models.poroelasticity.fpp_parameter``, ``h = sqrt(cell
-area)``). It is assembled exactly as
+area)``; in 3-D ``h = cbrt(cell volume)``, the same cell size for quadrilaterals and hexahedra,
+about half the edge of a regular tetrahedron). It is assembled exactly as
 ``S = M_eps - C diag(eps_f / |K|) C^T`` (``M_eps`` the eps_f-weighted Q1 mass matrix, ``C`` the
 Q1 x DG0 mixed mass matrix).
 
@@ -42,9 +44,16 @@ MUMPS factorisation per distinct dt through ``rkfx.linalg.linear_solver.Factoriz
 reuses the ordering of the matrix it replaces), with checkpoints and resume. The matrix is
 held whole on every rank and its rows distributed to MUMPS by ``rkfx.linalg.petsc``.
 
-Elements: ``"taylor-hood"`` (P2-P1 on triangles, Q2-Q1 on quadrilaterals; inf-sup stable),
-``"q1q1"`` (equal-order Q1-Q1 on quadrilaterals, P1-P1 on triangles; unstabilised, oscillates
-in the undrained limit) and ``"q1q1-fpp"`` (the same with FPP).
+Elements: ``"taylor-hood"`` (P2-P1 on triangles and tetrahedra, Q2-Q1 on quadrilaterals;
+inf-sup stable), ``"q1q1"`` (equal-order Q1-Q1 on quadrilaterals, P1-P1 on triangles and
+tetrahedra; unstabilised, oscillates in the undrained limit) and ``"q1q1-fpp"`` (the same with
+FPP).
+
+Meshes: 2-D (gdim 2) from :func:`rectangle_mesh` or gmsh, and 3-D tetrahedral meshes (gdim 3) of
+the gmsh solids of ``rkfx.geometry.gmsh_solids``, given as the ``MeshData`` of
+``fem_baselines.gmsh_mesh.build_mesh`` / ``mesh_from_gmsh`` so that conditions name the parts
+by their physical names (``x0``, ``surface``, ``top``, ...). Everything with a dimension
+follows the mesh's: displacements, sample points and condition components have gdim entries.
 
 Boundary conditions are those of ``rkfx.conditions``, the RKPM model's; parts and values reach
 dolfinx through ``fem_baselines.conditions``. The other dolfinx-specific calls of the poroelastic
@@ -77,6 +86,7 @@ import ufl
 
 from fem_baselines.conditions import BoundaryParts, check_kinds
 from fem_baselines.elasticity import strain, stress_law
+from fem_baselines.gmsh_mesh import mesh_parts
 from rkfx.conditions import Condition, Displacement, Flux, Pressure, Traction, values
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.linalg.linear_solver import Factorizations
@@ -99,6 +109,10 @@ ELEMENTS = ("taylor-hood", "q1q1", "q1q1-fpp")
 #: Mandel Taylor-Hood system 4x faster than the default.
 _MUMPS_ICNTL = {7: 2}
 
+#: In 3-D the METIS ordering (ICNTL(7) = 5) instead: it factorises the Taylor-Hood sphere octant
+#: (40k dofs) in 2.0 s where AMF takes 3.1 s.
+_MUMPS_ICNTL_3D = {7: 5}
+
 @dataclass
 class BiotResult:
     """Sampled history and final fields of a Biot FEM run.
@@ -107,8 +121,8 @@ class BiotResult:
         output_times: Times at which fields were sampled, shape (n_out,) [s].
         p: Pore pressure at the sample points, shape (n_out, m) [Pa]; NaN for points outside
             the mesh.
-        u: Displacement at the sample points, shape (n_out, m, 2) [m].
-        n_dofs: Global number of unknowns (2 per displacement node + 1 per pressure node).
+        u: Displacement at the sample points, shape (n_out, m, gdim) [m].
+        n_dofs: Global number of unknowns (gdim per displacement node + 1 per pressure node).
         wall_time_s: Wall-clock seconds of the whole call (setup incl. form JIT, all
             assemblies, factorisations and solves, sampling), max over ranks.
         mesh: The dolfinx mesh.
@@ -196,14 +210,15 @@ def rectangle_mesh(
 # --------------------------------------------------------------------------- helpers
 
 
-def _initial(field_of_x: Callable[[np.ndarray], Any], x: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
-    """An initial field ``field_of_x(x (2, n)) -> shape + (n,)`` at dolfinx's points x (3, n).
+def _initial(field_of_x: Callable[[np.ndarray], Any], x: np.ndarray, shape: tuple[int, ...],
+             gdim: int = 2) -> np.ndarray:
+    """An initial field ``field_of_x(x (gdim, n)) -> shape + (n,)`` at dolfinx's points x (3, n).
 
     Returns:
         Array of shape ``shape + (n,)``.
     """
     n = x.shape[1]
-    val = np.asarray(field_of_x(x[:2]), dtype=np.float64)
+    val = np.asarray(field_of_x(x[:gdim]), dtype=np.float64)
     if val.shape == shape:
         val = val[..., None]
     return np.ascontiguousarray(np.broadcast_to(val, (*shape, n)))
@@ -213,13 +228,14 @@ class _Sampler:
     """Point evaluation of (u, p) at fixed points; every rank gets the full arrays."""
 
     def __init__(self, mesh: dolfinx.mesh.Mesh, points: np.ndarray):
+        gdim = self.gdim = mesh.geometry.dim
         pts = np.atleast_2d(np.asarray(points, dtype=np.float64))
-        if pts.ndim != 2 or pts.shape[1] != 2:
-            raise ValueError(f"sample_points must have shape (m, 2), got {np.shape(points)}")
+        if pts.ndim != 2 or pts.shape[1] != gdim:
+            raise ValueError(f"sample_points must have shape (m, {gdim}) on a {gdim}D mesh, got {np.shape(points)}")
         self.comm = mesh.comm
         m = pts.shape[0]
         self.x3 = np.zeros((m, 3), dtype=mesh.geometry.x.dtype)
-        self.x3[:, :2] = pts
+        self.x3[:, :gdim] = pts
         tree = dolfinx.geometry.bb_tree(mesh, mesh.topology.dim)
         candidates = dolfinx.geometry.compute_collisions_points(tree, self.x3)
         colliding = dolfinx.geometry.compute_colliding_cells(mesh, candidates, self.x3)
@@ -234,15 +250,15 @@ class _Sampler:
         self.cells = np.asarray(colliding.array)[offsets[:-1][self.mine]].astype(np.int32)
 
     def __call__(self, uh: dolfinx.fem.Function, ph: dolfinx.fem.Function) -> tuple[np.ndarray, np.ndarray]:
-        m = self.x3.shape[0]
-        vals = np.zeros((m, 3), dtype=np.float64)
+        m, gdim = self.x3.shape[0], self.gdim
+        vals = np.zeros((m, gdim + 1), dtype=np.float64)  # [u, p] per point
         if np.any(self.mine):
-            vals[self.mine, :2] = uh.eval(self.x3[self.mine], self.cells).reshape(-1, 2)
-            vals[self.mine, 2] = ph.eval(self.x3[self.mine], self.cells).reshape(-1)
+            vals[self.mine, :gdim] = uh.eval(self.x3[self.mine], self.cells).reshape(-1, gdim)
+            vals[self.mine, gdim] = ph.eval(self.x3[self.mine], self.cells).reshape(-1)
         if self.comm.size > 1:
             self.comm.Allreduce(MPI.IN_PLACE, vals, op=MPI.SUM)
         vals[self.missing] = np.nan
-        return vals[:, 2].copy(), vals[:, :2].copy()
+        return vals[:, gdim].copy(), vals[:, :gdim].copy()
 
 
 # --------------------------------------------------------------------------- the model
@@ -281,8 +297,8 @@ class FemBiotModel:
     """Biot's u-p equations assembled by dolfinx, as a model for the steppers of ``rkfx.solvers``.
 
     The unknowns, the same on every rank, are ``[u, p]`` in dolfinx's global dof numbering: u
-    interleaved per node of the displacement space V, then p per node of Q; both of time order
-    1 (u is quasi-static; its rate enters the storage equation), or u of order 2 with the
+    interleaved per node of the displacement space V (gdim components), then p per node of Q;
+    both of time order 1 (u is quasi-static; its rate enters the storage equation), or u of order 2 with the
     consistent mass rho int v . u when ``density`` > 0 (u-p dynamics, eqs. 6.42-6.44). As in
     ``rkfx.models.poroelasticity.BiotModel``, C x' + r(x, t) = 0 with
 
@@ -299,33 +315,35 @@ class FemBiotModel:
     conditions are unit rows G x = g(t) on their dofs, one row per prescribed component (a dof
     named by several conditions takes the last one's value, as dolfinx's ``set_bc``).
 
-    Args: as :func:`solve_biot`.
+    Args: as :func:`solve_biot`, plus ``facet_tags`` and ``physical_groups`` (from gmsh, e.g.
+        ``fem_baselines.gmsh_mesh.mesh_from_gmsh``) that let conditions name parts.
     """
 
     def __init__(self, mesh: dolfinx.mesh.Mesh, E: float, nu: float, k: float, alpha: float, S: float,
                  element: str, conditions: Sequence[Condition], fpp_form: str = "rate", t0: float = 0.0,
-                 density: float = 0.0):
+                 density: float = 0.0, facet_tags: Any = None, physical_groups: dict[str, Any] | None = None):
         if not (np.isfinite(density) and density >= 0):
             raise ValueError(f"density = {density!r} must be >= 0 (0: quasi-static)")
         self.comm, self.material, self.density = mesh.comm, (E, nu, k, alpha, S), float(density)
+        gdim = self.gdim = mesh.geometry.dim
         mesh.topology.create_connectivity(mesh.topology.dim - 1, mesh.topology.dim)
         self._degree = 2 if element == "taylor-hood" else 1  # of u
-        self.V = dolfinx.fem.functionspace(mesh, ("Lagrange", self._degree, (2,)))
+        self.V = dolfinx.fem.functionspace(mesh, ("Lagrange", self._degree, (gdim,)))
         self.Q = dolfinx.fem.functionspace(mesh, ("Lagrange", 1))
         # Local (owned + ghost) dofs -> global unknowns.
         v_map, q_map = self.V.dofmap.index_map, self.Q.dofmap.index_map
         v_nodes = v_map.local_to_global(np.arange(v_map.size_local + v_map.num_ghosts, dtype=np.int32))
-        self._n_u = 2 * v_map.size_global
-        self.u_index = (2 * v_nodes[:, None] + np.arange(2)).ravel()
+        self._n_u = gdim * v_map.size_global
+        self.u_index = (gdim * v_nodes[:, None] + np.arange(gdim)).ravel()
         self.p_index = self._n_u + q_map.local_to_global(np.arange(q_map.size_local + q_map.num_ghosts,
                                                                    dtype=np.int32))
-        self.layout = FieldLayout((Field("u", 2, 2 if density > 0 else 1, v_map.size_global),
+        self.layout = FieldLayout((Field("u", gdim, 2 if density > 0 else 1, v_map.size_global),
                                    Field("p", 1, 1, q_map.size_global)))
         self.linear = True
         self.fpp = element == "q1q1-fpp"
         self.seed = self.fpp and fpp_form == "seed"
-        kinds = check_kinds(conditions, (Displacement, Pressure, Traction, Flux), "the Biot FEM", gdim=2)
-        self.boundary = BoundaryParts(mesh)
+        kinds = check_kinds(conditions, (Displacement, Pressure, Traction, Flux), "the Biot FEM", gdim=gdim)
+        self.boundary = BoundaryParts(mesh, facet_tags, physical_groups)
         self._assemble(mesh)
         self._natural_conditions(mesh, kinds[Traction], kinds[Flux])
         self._essential_conditions(mesh, kinds[Displacement] + kinds[Pressure])
@@ -365,7 +383,7 @@ class FemBiotModel:
             area = dolfinx.fem.assemble_vector(dolfinx.fem.form(mu0 * dx))
             area.scatter_reverse(dolfinx.la.InsertMode.add)
             area.scatter_forward()
-            self._cell_area = area.array.copy()  # owned + ghost cells [m^2]
+            self._cell_area = area.array.copy()  # owned + ghost cells [m^2] (volumes [m^3] in 3-D)
             self._cell_area_global = _gather(comm, self._cell_area[: DG0.dofmap.index_map.size_local])
             self._m_eps = dolfinx.fem.form(self._eps_f * p * q * dx)
 
@@ -375,7 +393,7 @@ class FemBiotModel:
         self._load_data: list[tuple[dolfinx.fem.Function, Traction | Flux]] = []
         v, q = ufl.TestFunction(self.V), ufl.TestFunction(self.Q)
         linear = {}
-        for what, parts, space, term in (("traction", tractions, ("Lagrange", self._degree, (2,)),
+        for what, parts, space, term in (("traction", tractions, ("Lagrange", self._degree, (self.gdim,)),
                                           lambda f: ufl.inner(f, v)),
                                          ("flux", fluxes, ("Lagrange", 2), lambda f: -f * q)):
             if not parts:
@@ -392,22 +410,22 @@ class FemBiotModel:
 
     def _essential_conditions(self, mesh: dolfinx.mesh.Mesh, essential: Sequence[Displacement | Pressure]) -> None:
         """Unit rows G on the owned dofs of each Dirichlet condition, data evaluated at their coordinates."""
-        fdim = mesh.topology.dim - 1
-        self._dirichlet = []  # (condition, coordinates (m, 2), global rows (m,), value column (m,)) of each
-        v_owned, q_owned = 2 * self.V.dofmap.index_map.size_local, self.Q.dofmap.index_map.size_local
+        fdim, gdim = mesh.topology.dim - 1, self.gdim
+        self._dirichlet = []  # (condition, coordinates (m, gdim), global rows (m,), value column (m,)) of each
+        v_owned, q_owned = gdim * self.V.dofmap.index_map.size_local, self.Q.dofmap.index_map.size_local
         v_points, q_points = self.V.tabulate_dof_coordinates(), self.Q.tabulate_dof_coordinates()
         for bc in essential:
             facets = self.boundary.facets(bc.boundary)
             if isinstance(bc, Displacement):  # the rows of every component, component by component
-                dofs = [dolfinx.fem.locate_dofs_topological(self.V.sub(c), fdim, facets) for c in bc.components]
+                dofs = [dolfinx.fem.locate_dofs_topological(self.V.sub(c), fdim, facets) for c in bc.prescribed(gdim)]
                 dofs = [d[d < v_owned] for d in dofs]  # unrolled
                 column = np.concatenate([np.full(d.size, j) for j, d in enumerate(dofs)])
                 dofs = np.concatenate(dofs)
-                self._dirichlet.append((bc, v_points[dofs // 2, :2], self.u_index[dofs], column))
+                self._dirichlet.append((bc, v_points[dofs // gdim, :gdim], self.u_index[dofs], column))
             else:
                 dofs = dolfinx.fem.locate_dofs_topological(self.Q, fdim, facets)
                 dofs = dofs[dofs < q_owned]
-                self._dirichlet.append((bc, q_points[dofs, :2], self.p_index[dofs], np.zeros(dofs.size, int)))
+                self._dirichlet.append((bc, q_points[dofs, :gdim], self.p_index[dofs], np.zeros(dofs.size, int)))
         rows = _in_order(self.comm, [r for _, _, r, _ in self._dirichlet]).astype(np.int64)
         self._bc_rows, last = np.unique(rows[::-1], return_index=True)
         self._bc_last = len(rows) - 1 - last  # where each constrained dof's value stands in the gathered list
@@ -424,7 +442,8 @@ class FemBiotModel:
     def vector(self, uh: dolfinx.fem.Function, ph: dolfinx.fem.Function) -> np.ndarray:
         """The global unknowns of (u_h, p_h)."""
         n_v, n_q = self.V.dofmap.index_map.size_local, self.Q.dofmap.index_map.size_local
-        return np.concatenate([_gather(self.comm, uh.x.array[: 2 * n_v]), _gather(self.comm, ph.x.array[:n_q])])
+        return np.concatenate([_gather(self.comm, uh.x.array[: self.gdim * n_v]),
+                               _gather(self.comm, ph.x.array[:n_q])])
 
     def assign(self, x: np.ndarray, uh: dolfinx.fem.Function, ph: dolfinx.fem.Function) -> None:
         """(u_h, p_h), ghosts included, from the global unknowns."""
@@ -467,10 +486,13 @@ class FemBiotModel:
 
     def stabilization(self, dt: float) -> sp.csr_matrix:
         """The FPP matrix S = M_eps - C diag(eps_f / |K|) C^T for steps of dt, shape ``(n_p, n_p)``."""
+        # h of eq. 3.53: sqrt(area) in 2-D, cbrt(volume) in 3-D (the cell's edge length either way)
+        size = np.sqrt if self.gdim == 2 else np.cbrt
+
         def build(dt):
             poro = PoroMaterial(*self.material)  # eps_f of eq. 3.53
-            self._eps_f.x.array[:] = fpp_parameter(poro, dt, np.sqrt(self._cell_area))
-            eps = fpp_parameter(poro, dt, np.sqrt(self._cell_area_global))
+            self._eps_f.x.array[:] = fpp_parameter(poro, dt, size(self._cell_area))
+            eps = fpp_parameter(poro, dt, size(self._cell_area_global))
             projection = self._ct.T @ sp.diags(eps / self._cell_area_global) @ self._ct
             return (_global_matrix(self._m_eps, self.comm) - projection).tocsr()
 
@@ -526,7 +548,7 @@ class _Samples:
         self.vtk = vtk
         m = sampler.x3.shape[0]
         self.p = np.full((len(steps), m), np.nan)
-        self.u = np.full((len(steps), m, 2), np.nan)
+        self.u = np.full((len(steps), m, sampler.gdim), np.nan)
         self.seconds = 0.0
 
     def record(self, s: StepState) -> None:
@@ -550,7 +572,7 @@ class _Samples:
 
 
 def solve_biot(
-    mesh: dolfinx.mesh.Mesh,
+    mesh: dolfinx.mesh.Mesh | dolfinx.io.gmsh.MeshData,
     E: float,
     nu: float,
     k: float,
@@ -573,7 +595,7 @@ def solve_biot(
     density: float = 0.0,
     stepper: Newmark | None = None,
 ) -> BiotResult:
-    """Solve plane-strain Biot consolidation with backward Euler and a monolithic u-p solve.
+    """Solve Biot consolidation (plane strain or 3-D) with backward Euler and a monolithic u-p solve.
 
     Collective on the mesh communicator. Boundaries not mentioned in ``conditions`` are traction-free
     and impermeable. The :class:`FemBiotModel` is stepped by ``rkfx.solvers.integrate`` with
@@ -581,7 +603,10 @@ def solve_biot(
     time step.
 
     Args:
-        mesh: A 2D dolfinx mesh (e.g. from :func:`rectangle_mesh`), triangles or quadrilaterals.
+        mesh: A 2D dolfinx mesh (e.g. from :func:`rectangle_mesh`), triangles or quadrilaterals;
+            or a 3D one of tetrahedra; or the ``MeshData`` of a gmsh model (2D or 3D) from
+            ``fem_baselines.gmsh_mesh.mesh_from_gmsh`` / ``build_mesh``, whose physical names
+            then name boundary parts.
         E: Drained Young's modulus [Pa].
         nu: Drained Poisson's ratio [-] (< 0.5).
         k: Mobility k_h / gamma_f [m^2/(Pa s)].
@@ -590,19 +615,22 @@ def solve_biot(
         element: ``"taylor-hood"`` (P2-P1 / Q2-Q1), ``"q1q1"`` (equal order, unstabilised) or
             ``"q1q1-fpp"`` (equal order with fluid pressure projection, eqs. 3.49-3.54).
         conditions: Boundary conditions of ``rkfx.conditions``: ``Displacement`` (a row per
-            listed component), ``Pressure``, ``Traction`` (total traction) and ``Flux`` (outward
-            normal flux). Parts are the sides ``"left"``, ``"right"``, ``"bottom"``, ``"top"``
-            of the mesh's bounding box or markers ``x (m, 2) -> bool`` (see
-            ``fem_baselines.conditions``). Functions of x and t (of x, t and n for tractions and
-            fluxes) are evaluated at t_{n+1} in step n+1.
+            listed component, components below gdim), ``Pressure``, ``Traction`` (total
+            traction) and ``Flux`` (outward normal flux). Parts are physical-group names (gmsh
+            ``MeshData``), facet tags, the sides of the mesh's bounding box (``"left"``,
+            ``"right"``, ``"bottom"``, ``"top"`` in 2-D; ``"left"``/``"right"``,
+            ``"front"``/``"back"``, ``"bottom"``/``"top"`` along x, y, z in 3-D) or markers
+            ``x (m, gdim) -> bool`` (see ``fem_baselines.conditions``). Functions of x and t (of
+            x, t and n for tractions and fluxes), with x and n of shape (m, gdim), are evaluated
+            at t_{n+1} in step n+1.
         times: Time levels t_0 < t_1 < ... < t_N, shape (N+1,) [s]; the initial state is at t_0.
-        sample_points: Points where fields are sampled, shape (m, 2) [m].
+        sample_points: Points where fields are sampled, shape (m, gdim) [m].
         output_times: Times at which to sample, each exactly equal to an entry of ``times``,
             shape (n_out,) [s].
         comm: Unused beyond a consistency check (the mesh's communicator is used); kept for the
             house signature.
-        initial_u: Initial displacement ``u0(x) -> (2, n)`` with x of shape (2, n); default 0.
-        initial_p: Initial pressure ``p0(x) -> (n,)``; default 0.
+        initial_u: Initial displacement ``u0(x) -> (gdim, n)`` with x of shape (gdim, n); default 0.
+        initial_p: Initial pressure ``p0(x) -> (n,)`` with x of shape (gdim, n); default 0.
         fpp_form: ``"rate"`` (default, as in ``rkfx.models.poroelasticity``): ``-S`` acting on
             ``P_n+1 - P_n`` (White & Borja's form, stabilising the pressure rate; dimensionally
             consistent with eps_f in 1/Pa); ``"seed"``: ``-dt S`` in the p-p block as eq. 3.51
@@ -630,6 +658,7 @@ def solve_biot(
         rkfx.errors.SolverError: If a linear solve fails.
     """
     t_start = time.perf_counter()
+    mesh, facet_tags, physical_groups = mesh_parts(mesh)
     if comm is not None and comm.size != mesh.comm.size:
         raise ValueError("comm must be the mesh's communicator")
     comm = mesh.comm
@@ -637,8 +666,10 @@ def solve_biot(
         raise ValueError(f"element must be one of {ELEMENTS}, got {element!r}")
     if fpp_form not in ("seed", "rate"):
         raise ValueError(f"fpp_form must be 'seed' or 'rate', got {fpp_form!r}")
-    if mesh.geometry.dim != 2:
-        raise ValueError("solve_biot expects a 2D mesh (gdim 2)")
+    gdim = mesh.geometry.dim
+    if gdim not in (2, 3) or mesh.topology.dim != gdim:
+        raise ValueError(f"solve_biot expects a 2D or 3D mesh whose cells fill it (gdim = tdim), got gdim {gdim} "
+                         f"and tdim {mesh.topology.dim}")
     times = np.asarray(times, dtype=np.float64)
     if times.ndim != 1 or len(times) < 2 or not np.all(np.diff(times) > 0):
         raise ValueError("times must be a strictly increasing 1-D array with at least 2 entries")
@@ -651,22 +682,23 @@ def solve_biot(
         raise ValueError(f"need E > 0, -1 < nu < 0.5, k >= 0, S >= 0; got E={E}, nu={nu}, k={k}, S={S}")
 
     model = FemBiotModel(mesh, E, nu, k, alpha, S, element, conditions, fpp_form, t0=float(times[0]),
-                         density=density)
+                         density=density, facet_tags=facet_tags, physical_groups=physical_groups)
     if stepper is None:
         stepper = backward_euler() if density == 0 else Newmark(beta=0.25, gamma=0.5, theta=0.5)
     uh = dolfinx.fem.Function(model.V, name="u")
     ph = dolfinx.fem.Function(model.Q, name="p")
     if initial_u is not None:
-        uh.interpolate(lambda x: _initial(initial_u, x, (2,)))
+        uh.interpolate(lambda x: _initial(initial_u, x, (gdim,), gdim))
     if initial_p is not None:
-        ph.interpolate(lambda x: _initial(initial_p, x, ()))
+        ph.interpolate(lambda x: _initial(initial_p, x, (), gdim))
     n = model.layout.size
     start = stepper.start(model, model.vector(uh, ph), t0=float(times[0]), comm=comm)
     kept = _Samples(model, _Sampler(mesh, sample_points), out_index, uh, ph, vtk)
     kept.record(start)
     t_setup, sampled = time.perf_counter() - t_start, kept.seconds
 
-    solves = Factorizations(comm, "mumps", keep=2, mumps_icntl=_MUMPS_ICNTL, reuse_analysis=True)
+    solves = Factorizations(comm, "mumps", keep=2, mumps_icntl=_MUMPS_ICNTL if gdim == 2 else _MUMPS_ICNTL_3D,
+                            reuse_analysis=True)
     try:
         run = integrate(stepper, model, times, start=start, recorder=kept, solves=solves, max_cuts=0,
                         checkpoint_every=checkpoint_every, checkpoint_dir=checkpoint_dir, resume=resume,

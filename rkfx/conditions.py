@@ -62,18 +62,25 @@ def _check_value(condition) -> None:
 
 @dataclass(frozen=True)
 class _Vectorial:
-    """A condition on some components of a vector field."""
+    """A condition on some components of a vector field; ``components=None`` (the default) means
+    every component: x and y in 2-D, x, y and z in 3-D (``prescribed(dim)``)."""
 
     boundary: Boundary
     value: Value = 0.0
-    components: tuple[int, ...] = (0, 1)
+    components: tuple[int, ...] | None = None
 
     def __post_init__(self):
         _check_value(self)
+        if self.components is None:
+            return
         comps = tuple(self.components)
         if not comps or len(set(comps)) != len(comps) or any(int(k) != k or k < 0 or k > 2 for k in comps):
             raise InputError(f"{type(self).__name__} on {self.boundary!r}: components {self.components!r} must be "
                              "distinct indices 0 (x), 1 (y) or 2 (z)")
+
+    def prescribed(self, dim: int) -> tuple[int, ...]:
+        """The prescribed components in ``dim`` dimensions (all of them when ``components`` is None)."""
+        return tuple(range(dim)) if self.components is None else tuple(self.components)
 
 
 @dataclass(frozen=True)
@@ -86,6 +93,10 @@ class _Scalar:
 
     def __post_init__(self):
         _check_value(self)
+
+    def prescribed(self, dim: int) -> tuple[int, ...]:
+        """The one component of the scalar field, ``(0,)``."""
+        return (0,)
 
 
 class Displacement(_Vectorial):
@@ -118,7 +129,8 @@ NATURAL = (Traction, Flux)
 
 
 def values(condition: Condition, x: np.ndarray, t: float = 0.0, n: np.ndarray | None = None) -> np.ndarray:
-    """The condition's value at points x and time t, shape ``(m, len(components))``.
+    """The condition's value at points x and time t, shape ``(m, len(components))`` (the
+    prescribed components in the dimension of x, ``condition.prescribed(gdim)``).
 
     Args:
         condition: Any condition of this module.
@@ -128,7 +140,7 @@ def values(condition: Condition, x: np.ndarray, t: float = 0.0, n: np.ndarray | 
     """
     x = np.asarray(x, float)
     m = len(x)
-    comps = list(condition.components)
+    comps = list(condition.prescribed(x.shape[1]))
     v = condition.value
     if not callable(v):
         out = v

@@ -94,7 +94,7 @@ def test_unknown_names_and_empty_markers_name_the_part_and_the_fix():
         part_nodes(P, 3)
     with pytest.raises(InputError, match="collocation takes .*Displacement or .*Velocity or .*Pressure"):
         transformation_constraints(P, RK, [Traction("top", (0.0, 1.0))])
-    with pytest.raises(InputError, match="solve_plane_strain takes .*Displacement and Traction conditions, not"):
+    with pytest.raises(InputError, match="solve_elasticity takes .*Displacement and Traction conditions, not"):
         solve_plane_strain(P, ElasticMaterial(1, 0.3), [Displacement("left", 0.0), Velocity("right", 1.0)])
 
 

@@ -53,7 +53,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from verification.moduli import DrainedModuli
+from verification.moduli import BiotModuli
 
 _DECAY_EXPONENT = 40.0
 _MIN_ROOTS = 500
@@ -92,7 +92,7 @@ def _roots(ratio: float, n: int) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class Mandel(DrainedModuli):
+class Mandel(BiotModuli):
     """Mandel's problem for general Biot parameters (S = 0 allowed).
 
     Attributes:
@@ -120,29 +120,6 @@ class Mandel(DrainedModuli):
             raise ValueError("need alpha > 0 and S >= 0")
 
     # ----- moduli -----
-    @property
-    def K_u(self) -> float:
-        """Undrained bulk modulus K + alpha^2/S [Pa]; inf for S = 0."""
-        return np.inf if self.S == 0.0 else self.K + self.alpha**2 / self.S
-
-    @property
-    def B(self) -> float:
-        """Skempton's coefficient alpha M / K_u = alpha / (alpha^2 + S K) [-]; 1/alpha at S = 0."""
-        return self.alpha / (self.alpha**2 + self.S * self.K)
-
-    @property
-    def nu_u(self) -> float:
-        """Undrained Poisson's ratio [-]; exactly 1/2 for S = 0."""
-        if self.S == 0.0:
-            return 0.5
-        w = self.alpha**2 + self.S * self.K           # = S K_u
-        return (3.0 * w - 2.0 * self.S * self.G) / (2.0 * (3.0 * w + self.S * self.G))
-
-    @property
-    def c(self) -> float:
-        """Consolidation coefficient k K_v / (alpha^2 + S K_v) [m^2/s]."""
-        return self.k * self.K_v / (self.alpha**2 + self.S * self.K_v)
-
     @property
     def c_cheng(self) -> float:
         """c = 2 k B^2 G (1-nu)(1+nu_u)^2 / (9 (1-nu_u)(nu_u-nu)), Cheng's form [m^2/s]."""

@@ -1,8 +1,9 @@
-"""Manufactured plane-strain elasticity solutions for convergence studies.
+"""Manufactured elasticity solutions (plane strain and 3-D) for convergence studies.
 
 ``sine_field``: u = (A sin(pi x) cos(pi y), B x^2 y) with the body force f = -div sigma
 that makes it exact for any Lame constants (plane strain, Voigt strain with engineering shear).
 ``linear_field``: an arbitrary linear displacement, the linear patch test.
+``SineField3D``: a smooth 3-D displacement with its body force.
 """
 from dataclasses import dataclass
 
@@ -79,3 +80,60 @@ class LinearField:
         eps = 0.5 * (g + g.T)
         sigma = self.lam * np.trace(eps) * np.eye(2) + 2 * self.mu * eps
         return n @ sigma.T
+
+
+@dataclass(frozen=True)
+class SineField3D:
+    """A smooth 3-D elastic solution with its body force, for any Lame constants.
+
+    u = A (sin(pi x_i) prod_(j != i) cos(pi x_j))_i + B (x^2 y, y^2 z, z^2 x). The first part is
+    -grad(Phi)/pi with Phi = cos(pi x) cos(pi y) cos(pi z), so Lap u = grad div u = -3 pi^2 u
+    there; the second is not a gradient. f = -div sigma = -(lam + mu) grad div u - mu Lap u.
+    """
+
+    lam: float
+    mu: float
+    A: float = 0.1
+    B: float = 0.05
+
+    def displacement(self, x: np.ndarray) -> np.ndarray:
+        """Shape ``(m, 3)`` [m] at ``x`` of shape ``(m, 3)``."""
+        s, c = np.sin(np.pi * x), np.cos(np.pi * x)
+        wave = np.column_stack([s[:, 0] * c[:, 1] * c[:, 2], c[:, 0] * s[:, 1] * c[:, 2], c[:, 0] * c[:, 1] * s[:, 2]])
+        X, Y, Z = x.T
+        return self.A * wave + self.B * np.column_stack([X**2 * Y, Y**2 * Z, Z**2 * X])
+
+    def gradient(self, x: np.ndarray) -> np.ndarray:
+        """du_i/dx_j, shape ``(m, 3, 3)``."""
+        s, c = np.sin(np.pi * x), np.cos(np.pi * x)
+        g = np.empty((len(x), 3, 3))
+        for i in range(3):
+            for j in range(3):
+                k = 3 - i - j  # the third axis when i != j
+                if i == j:
+                    g[:, i, j] = np.pi * np.prod(c, axis=1)
+                else:
+                    g[:, i, j] = -np.pi * s[:, i] * s[:, j] * c[:, k]
+        X, Y, Z = x.T
+        zero = np.zeros(len(x))
+        poly = np.stack([np.column_stack([2 * X * Y, X**2, zero]), np.column_stack([zero, 2 * Y * Z, Y**2]),
+                         np.column_stack([Z**2, zero, 2 * Z * X])], axis=1)
+        return self.A * g + self.B * poly
+
+    def body_force(self, x: np.ndarray) -> np.ndarray:
+        """f = -div sigma, shape ``(m, 3)`` [N/m^3]."""
+        lam, mu = self.lam, self.mu
+        s, c = np.sin(np.pi * x), np.cos(np.pi * x)
+        wave = np.column_stack([s[:, 0] * c[:, 1] * c[:, 2], c[:, 0] * s[:, 1] * c[:, 2], c[:, 0] * c[:, 1] * s[:, 2]])
+        X, Y, Z = x.T
+        grad_div = np.column_stack([2 * Y + 2 * Z, 2 * X + 2 * Z, 2 * X + 2 * Y])  # of the polynomial part
+        lap = np.column_stack([2 * Y, 2 * Z, 2 * X])
+        div_sigma = -3 * np.pi**2 * (lam + 2 * mu) * self.A * wave + self.B * ((lam + mu) * grad_div + mu * lap)
+        return -div_sigma
+
+    def stress(self, x: np.ndarray) -> np.ndarray:
+        """Voigt stress (xx, yy, zz, yz, xz, xy), shape ``(m, 6)`` [Pa]."""
+        g = self.gradient(x)
+        eps = 0.5 * (g + np.transpose(g, (0, 2, 1)))
+        sig = self.lam * np.trace(eps, axis1=1, axis2=2)[:, None, None] * np.eye(3) + 2 * self.mu * eps
+        return np.column_stack([sig[:, 0, 0], sig[:, 1, 1], sig[:, 2, 2], sig[:, 1, 2], sig[:, 0, 2], sig[:, 0, 1]])

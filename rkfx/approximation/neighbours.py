@@ -118,13 +118,18 @@ def support_neighbours(x: np.ndarray, a: np.ndarray, points: np.ndarray) -> tupl
     """Nodes J with |p - x_J| < a_J for every point p.
 
     Args:
-        x: Node coordinates, shape ``(num_nodes, 2)`` [m].
+        x: Node coordinates, shape ``(num_nodes, 2)`` [m] (or ``(num_nodes, 3)``: the search of
+            ``rkfx.approximation.neighbours3d``).
         a: Support radii, shape ``(num_nodes,)`` [m].
-        points: Evaluation points, shape ``(num_points, 2)`` [m].
+        points: Evaluation points, shape ``(num_points, 2)`` [m] (``(num_points, 3)`` in 3-D).
 
     Returns:
         ``(indptr, indices)``: CSR rows, shapes ``(num_points + 1,)`` int64 and ``(nnz,)`` int32.
     """
+    if np.shape(x)[1] == 3:
+        from rkfx.approximation.neighbours3d import support_neighbours_3d  # noqa: PLC0415 (imports this module)
+
+        return support_neighbours_3d(x, a, points)
     x = np.ascontiguousarray(x, dtype=np.float64)
     a = np.ascontiguousarray(a, dtype=np.float64)
     points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)

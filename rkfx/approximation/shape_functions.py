@@ -28,10 +28,10 @@ class RKApproximation:
     """Nodes, supports and basis order of an RK approximation.
 
     Attributes:
-        x: Node coordinates, shape ``(num_nodes, 2)`` [m].
+        x: Node coordinates, shape ``(num_nodes, 2)`` or ``(num_nodes, 3)`` [m].
         support: Support radius a_I of each node, shape ``(num_nodes,)`` [m].
-        order: Degree of the complete monomial basis H (1 linear, 2 quadratic).
-        cracks: Pre-existing cracks cutting the supports (diffraction method), or ``None``.
+        order: Degree of the complete monomial basis H (1 linear, 2 quadratic; 3-D: linear).
+        cracks: Pre-existing cracks cutting the supports (diffraction method, 2-D), or ``None``.
     """
 
     x: np.ndarray
@@ -43,16 +43,21 @@ class RKApproximation:
     def num_nodes(self) -> int:
         return len(self.x)
 
+    @property
+    def dim(self) -> int:
+        """Spatial dimension, 2 or 3."""
+        return self.x.shape[1]
+
 
 def rk_approximation(x: np.ndarray, spacing: np.ndarray, support_factor: float = 1.5,
                      order: int = 1, cracks: Cracks | None = None) -> RKApproximation:
     """RK approximation with support a_I = c * h_I.
 
     Args:
-        x: Node coordinates, shape ``(num_nodes, 2)`` [m].
+        x: Node coordinates, shape ``(num_nodes, 2)``, or ``(num_nodes, 3)`` in 3-D [m].
         spacing: Nodal spacing h_I, shape ``(num_nodes,)`` [m].
         support_factor: c > 0; 1.5 is the seed's choice for the linear basis.
-        order: 1 (linear) or 2 (quadratic) basis.
+        order: 1 (linear) or 2 (quadratic) basis; 3-D takes the linear basis.
         cracks: Pre-existing cracks (diffraction method); nodes must not lie on them
             (``rkfx.geometry.particles.cut_triangulation`` splits a node set along a crack).
     """
@@ -62,6 +67,11 @@ def rk_approximation(x: np.ndarray, spacing: np.ndarray, support_factor: float =
     if order not in (1, 2):
         raise InputError(f"order = {order!r} is not supported; use 1 (linear) or 2 (quadratic)")
     x = np.ascontiguousarray(x, dtype=np.float64)
+    if x.ndim != 2 or x.shape[1] not in (2, 3):
+        raise InputError(f"nodes of shape {x.shape}: give (num_nodes, 2) or (num_nodes, 3) coordinates")
+    if x.shape[1] == 3 and (order != 1 or cracks is not None):
+        raise InputError("3-D RK approximations take the linear basis (order=1) and no cracks; "
+                         f"got order={order!r}, cracks={'given' if cracks is not None else None}")
     spacing = np.broadcast_to(np.asarray(spacing, dtype=np.float64), (len(x),))
     bad = np.flatnonzero(~(spacing > 0))
     if bad.size:
@@ -411,9 +421,12 @@ def evaluate(rk: RKApproximation, points: np.ndarray, gradients: bool = False, i
     Returns rows over nodes whose entry vectors are ``[N_I]``, or ``[N_I, N_I,x, N_I,y]`` with
     ``gradients=True``, or ``[N_I, N^∇_Ix, N^∇_Iy]`` with ``implicit=True``.
 
+    In 3-D (``rk.dim == 3``) the entry vectors carry three gradient components
+    (``rkfx.approximation.shape_functions3d``).
+
     Args:
         rk: The approximation.
-        points: Evaluation points, shape ``(num_points, 2)`` [m].
+        points: Evaluation points, shape ``(num_points, rk.dim)`` [m].
         gradients: Also compute direct gradients (3.25 differentiated).
         implicit: Also compute implicit gradients (6.29): the rows that reproduce the gradients
             of linear (or, with ``order=2``, quadratic) fields, at almost no cost beyond N_I.
@@ -425,6 +438,8 @@ def evaluate(rk: RKApproximation, points: np.ndarray, gradients: bool = False, i
     if gradients and implicit:
         raise InputError("evaluate: ask for direct (gradients=True) or implicit gradients, not both")
     mode = DIRECT if gradients else IMPLICIT if implicit else VALUES
+    if rk.dim == 3:
+        return _evaluate_3d(rk, points, mode)
     points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
     g = cell_grid(rk.x, rk.support, points)
     grid = (g.origin, g.cell, *g.shape, g.start, g.order)
@@ -448,14 +463,30 @@ def evaluate(rk: RKApproximation, points: np.ndarray, gradients: bool = False, i
     else:
         _rows_generic(rk.x, rk.support, points, scale, *grid, indptr, kmax, mode, rk.order, *cut,
                       indices, out, ratio)
+    _check_conditioning(rk, points, ratio, counts)
+    return SparseRows(indptr, indices, out, rk.num_nodes)
+
+
+def _evaluate_3d(rk: RKApproximation, points: np.ndarray, mode: int) -> SparseRows:
+    from rkfx.approximation.shape_functions3d import evaluate_3d  # noqa: PLC0415 (it imports this module)
+
+    points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 3)
+    rows, ratio, counts = evaluate_3d(rk.x, rk.support, rk.num_nodes, points, mode, RCOND_MIN)
+    _check_conditioning(rk, points, ratio, counts)
+    return rows
+
+
+def _check_conditioning(rk: RKApproximation, points: np.ndarray, ratio: np.ndarray, counts: np.ndarray) -> None:
+    """Raise ``SingularMomentMatrix`` naming the first point whose moment matrix is singular."""
     bad = np.flatnonzero(~(ratio >= RCOND_MIN))
     if bad.size:
         p = bad[0]
         near = int(np.argmin(np.sum((rk.x - points[p]) ** 2, axis=1)))
+        need = rk.dim + 1 if rk.order == 1 else (rk.order + 1) * (rk.order + 2) // 2
+        flat = "non-coplanar" if rk.dim == 3 else "non-collinear"
         raise SingularMomentMatrix(
             f"singular moment matrix at point {p} {point_str(points[p])} "
             f"({len(bad)} such points): covered by {counts[p]} node supports "
             f"(nearest node {near} at {point_str(rk.x[near])}, support "
             f"{rk.support[near]:.4g}); increase support_factor, it needs >= "
-            f"{(rk.order + 1) * (rk.order + 2) // 2} non-collinear nodes in reach of every point")
-    return SparseRows(indptr, indices, out, rk.num_nodes)
+            f"{need} {flat} nodes in reach of every point")

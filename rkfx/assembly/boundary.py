@@ -39,11 +39,12 @@ BC_METHODS = ("transformation", "nitsche")
 
 @dataclass(frozen=True)
 class BoundaryQuadrature:
-    """Gauss points on boundary half-segments with shape rows [N, N_x, N_y].
+    """Points on the boundary (Gauss points of the boundary half-segments in 2-D, the facet
+    centroids of the nodal cells in 3-D) with shape rows [N, N_x, N_y(, N_z)].
 
     Attributes:
-        points, normals: Shape ``(m, 2)``.
-        weights: Shape ``(m,)`` [m].
+        points, normals: Shape ``(m, 2)`` (``(m, 3)`` in 3-D).
+        weights: Shape ``(m,)`` [m] (facet areas [m^2] in 3-D).
         tag: Boundary tag of each point, shape ``(m,)``.
         spacing: Nodal spacing of the segment's owning node, shape ``(m,)`` [m].
         rows: Shape rows at the points.
@@ -59,28 +60,42 @@ class BoundaryQuadrature:
     def select(self, tags: Sequence[int]) -> np.ndarray:
         return np.isin(self.tag, list(tags))
 
+    @property
+    def dim(self) -> int:
+        """Spatial dimension, 2 or 3."""
+        return self.points.shape[1]
+
 
 def boundary_quadrature(p: Particles, domains: NodalDomains, rk: RKApproximation,
                         points_per_segment: int = 1, segments: np.ndarray | None = None) -> BoundaryQuadrature:
-    """Gauss-Legendre points on every boundary half-segment (1 point = SCNI's midpoint rule).
+    """Gauss-Legendre points on every boundary half-segment (1 point = SCNI's midpoint rule);
+    in 3-D (``domains`` a ``rkfx.geometry.nodal_cells3d.NodalCells3D``) the centroids of the
+    cells' planar boundary facets, weights their areas (the points SCNI's divergence form uses;
+    ``points_per_segment`` must be 1).
 
-    ``segments`` (indices of boundary half-segments, e.g. those of a rank's owned nodes) keeps
-    every point but gives shape rows and weights only to the points of those segments; the
-    others get empty rows and zero weight, so boundary parts are still resolved on the whole
-    boundary and the loads and Nitsche terms sum to the whole ones over a partition.
+    ``segments`` (indices of boundary half-segments, or of boundary facets in 3-D, e.g. those of
+    a rank's owned nodes) keeps every point but gives shape rows and weights only to the points
+    of those segments; the others get empty rows and zero weight, so boundary parts are still
+    resolved on the whole boundary and the loads and Nitsche terms sum to the whole ones over a
+    partition.
     """
     if points_per_segment < 1:
         raise InputError(f"points_per_segment = {points_per_segment!r} must be >= 1")
     b = domains.boundary
-    s, w = np.polynomial.legendre.leggauss(points_per_segment)
-    t = 0.5 * (s + 1.0)
-    pts = (b.ends[:, None, 0] * (1 - t)[None, :, None] + b.ends[:, None, 1] * t[None, :, None]).reshape(-1, 2)
     k = points_per_segment
-    weights = (0.5 * np.outer(b.length, w)).ravel()
+    if p.x.shape[1] == 3:
+        if k != 1:
+            raise InputError(f"points_per_segment = {k!r}: 3-D boundary facets take their centroid only (1)")
+        pts, normals, weights = domains.points[b.point], b.normal, b.area.copy()
+    else:
+        s, w = np.polynomial.legendre.leggauss(points_per_segment)
+        t = 0.5 * (s + 1.0)
+        pts = (b.ends[:, None, 0] * (1 - t)[None, :, None] + b.ends[:, None, 1] * t[None, :, None]).reshape(-1, 2)
+        normals, weights = np.repeat(b.normal, k, axis=0), (0.5 * np.outer(b.length, w)).ravel()
     if segments is None:
         rows = evaluate(rk, pts, gradients=True)
     else:
-        keep = np.zeros(len(b.length), bool)
+        keep = np.zeros(len(b.node), bool)
         keep[segments] = True
         keep = np.repeat(keep, k)
         weights = np.where(keep, weights, 0.0)
@@ -88,9 +103,8 @@ def boundary_quadrature(p: Particles, domains: NodalDomains, rk: RKApproximation
         indptr = np.zeros(len(pts) + 1, np.int64)
         indptr[1:][keep] = np.diff(mine.indptr)
         rows = SparseRows(np.cumsum(indptr), mine.indices, mine.data, mine.num_cols)
-    return BoundaryQuadrature(
-        points=pts, normals=np.repeat(b.normal, k, axis=0), weights=weights,
-        tag=np.repeat(b.tag, k), spacing=np.repeat(p.spacing[b.node], k), rows=rows)
+    return BoundaryQuadrature(points=pts, normals=normals, weights=weights, tag=np.repeat(b.tag, k),
+                              spacing=np.repeat(p.spacing[b.node], k), rows=rows)
 
 
 def _only(conditions: Sequence[Condition], kinds: tuple[type, ...], where: str) -> Sequence[Condition]:
@@ -157,7 +171,7 @@ def part_points(p: Particles, bq: BoundaryQuadrature, boundary: Boundary) -> np.
 
 def traction_load(p: Particles, bq: BoundaryQuadrature, tractions: Sequence[Traction],
                   t: float = 0.0) -> np.ndarray:
-    """f_I = int_Gamma_t N_I t_bar dGamma (eq. 3.36) at time t, interleaved, shape ``(2 n,)``.
+    """f_I = int_Gamma_t N_I t_bar dGamma (eq. 3.36) at time t, interleaved, shape ``(g n,)`` (g = 2 or 3).
 
     Args:
         tractions: ``rkfx.conditions.Traction`` conditions; value(x, t, n) is evaluated at the
@@ -165,7 +179,7 @@ def traction_load(p: Particles, bq: BoundaryQuadrature, tractions: Sequence[Trac
             not listed carry no traction.
         t: Time [s].
     """
-    f = np.zeros((p.num_nodes, 2))
+    f = np.zeros((p.num_nodes, bq.dim))
     nmat = bq.rows.matrix(0)
     for tr in _only(tractions, (Traction,), "traction_load"):
         sel = part_points(p, bq, tr.boundary)
@@ -175,9 +189,9 @@ def traction_load(p: Particles, bq: BoundaryQuadrature, tractions: Sequence[Trac
 
 def traction_values(traction: Traction, bq: BoundaryQuadrature, sel: np.ndarray, t: float = 0.0) -> np.ndarray:
     """t_bar(x, t, n) at the boundary quadrature points ``sel`` (indices), shape ``(len(sel), 2)``:
-    zero in the components the traction does not list."""
-    tv = np.zeros((len(sel), 2))
-    tv[:, list(traction.components)] = values(traction, bq.points[sel], t, bq.normals[sel])
+    zero in the components the traction does not list (``(len(sel), 3)`` in 3-D)."""
+    tv = np.zeros((len(sel), bq.dim))
+    tv[:, list(traction.prescribed(bq.dim))] = values(traction, bq.points[sel], t, bq.normals[sel])
     return tv
 
 
@@ -219,7 +233,7 @@ def collocation(p: Particles, rk: RKApproximation, fields: Sequence[tuple[Sequen
     for conditions, offset, ncomp in fields:
         for bc in _only(conditions, ESSENTIAL, "collocation"):
             nodes = part_nodes(p, bc.boundary)
-            for j, c in enumerate(bc.components):
+            for j, c in enumerate(bc.prescribed(p.x.shape[1])):
                 fresh = np.array([(offset, c, i) not in seen for i in nodes], bool)
                 seen.update((offset, c, i) for i in nodes)
                 sel = nodes[fresh] if only is None else nodes[fresh & np.isin(nodes, only)]
@@ -235,10 +249,12 @@ def collocation(p: Particles, rk: RKApproximation, fields: Sequence[tuple[Sequen
 
 def transformation_constraints(p: Particles, rk: RKApproximation, conditions: Sequence[Condition],
                                t: float = 0.0, nodes: np.ndarray | None = None) -> tuple[sp.csr_matrix, np.ndarray]:
-    """Rows G (k, 2n) and values g (k,) at time t of u^h_c(x_I) = u_bar_c(x_I, t) at the nodes
-    of Gamma_u, for essential conditions of ``rkfx.conditions`` on the displacement field (or
-    its velocity, ``Velocity``); with ``nodes``, only at those of them (see ``collocation``)."""
-    col = collocation(p, rk, [(conditions, 0, 2)], 2 * p.num_nodes, nodes)
+    """Rows G (k, g n) and values g (k,) at time t of u^h_c(x_I) = u_bar_c(x_I, t) at the nodes
+    of Gamma_u (g = 2, or 3 in 3-D), for essential conditions of ``rkfx.conditions`` on the
+    displacement field (or its velocity, ``Velocity``); with ``nodes``, only at those of them
+    (see ``collocation``)."""
+    g = p.x.shape[1]
+    col = collocation(p, rk, [(conditions, 0, g)], g * p.num_nodes, nodes)
     return col.G, col.values(p.x, t)
 
 
@@ -284,7 +300,7 @@ def nitsche_rows(p: Particles, bq: BoundaryQuadrature, d: np.ndarray, conditions
     """The Nitsche rows of every condition with boundary points (``NitscheRows``).
 
     Args:
-        d: Elasticity matrix (3, 3) [Pa] of the traction t(u) = T D B u.
+        d: Elasticity matrix (3, 3) [Pa] of the traction t(u) = T D B u ((6, 6) in 3-D).
         conditions: ``rkfx.conditions.Displacement`` conditions, on their parts' boundary
             quadrature points (``part_points``).
         penalty: Dimensionless Nitsche parameter.
@@ -294,7 +310,9 @@ def nitsche_rows(p: Particles, bq: BoundaryQuadrature, d: np.ndarray, conditions
     from rkfx.materials.elasticity import traction_operator  # noqa: PLC0415
     from rkfx.assembly.operators import block_diagonal, strain_matrix  # noqa: PLC0415
 
-    n2 = 2 * p.num_nodes
+    g = bq.dim
+    v = 3 if g == 2 else 6
+    n2 = g * p.num_nodes
     grad = SparseRows(bq.rows.indptr, bq.rows.indices, bq.rows.data[:, 1:], bq.rows.num_cols)
     b_all = strain_matrix(grad)
     out = []
@@ -305,14 +323,14 @@ def nitsche_rows(p: Particles, bq: BoundaryQuadrature, d: np.ndarray, conditions
         m = len(sel)
         nmat = bq.rows.matrix(0)[sel]
         # Displacement rows u_c(x_q) for the prescribed components c: (m * nc, 2n).
-        comps = list(bc.components)
-        proj = sp.vstack([sp.csr_matrix((nmat.data, nmat.indices * 2 + c, nmat.indptr), shape=(m, n2))
+        comps = list(bc.prescribed(g))
+        proj = sp.vstack([sp.csr_matrix((nmat.data, nmat.indices * g + c, nmat.indptr), shape=(m, n2))
                           for c in comps]).tocsr()
         # Traction rows t_c(u)(x_q) = (T D B u)_c for the same components.
-        bq_rows = b_all[np.ravel(3 * sel[:, None] + np.arange(3))]
+        bq_rows = b_all[np.ravel(v * sel[:, None] + np.arange(v))]
         tdb = np.einsum("mij,jk->mik", traction_operator(bq.normals[sel]), d)
-        trac = block_diagonal(tdb) @ bq_rows  # (2 m, 2n), rows (q, component)
-        trac = sp.vstack([trac[c::2] for c in comps]).tocsr()
+        trac = block_diagonal(tdb) @ bq_rows  # (g m, g n), rows (q, component)
+        trac = sp.vstack([trac[c::g] for c in comps]).tocsr()
         out.append(NitscheRows(bc, sel, comps, proj, trac, np.tile(bq.weights[sel], len(comps)),
                                penalty * d[0, 0] / np.tile(bq.spacing[sel], len(comps)),
                                np.concatenate([bq.normals[sel, c] for c in comps])))
@@ -330,7 +348,7 @@ def nitsche_terms(p: Particles, bq: BoundaryQuadrature, d: np.ndarray, condition
         penalty: Dimensionless Nitsche parameter.
         t: Time [s].
     """
-    n2 = 2 * p.num_nodes
+    n2 = bq.dim * p.num_nodes
     k_total = sp.csr_matrix((n2, n2))
     f_total = np.zeros(n2)
     for rows in nitsche_rows(p, bq, d, conditions, penalty):
@@ -345,7 +363,7 @@ def nitsche_pressure_coupling(bq: BoundaryQuadrature, rows: Sequence[NitscheRows
     consistency term -int eta.(sigma n) of the u-p equations (the momentum rows then hold
     -(K_up - C) p)."""
     n = bq.rows.num_cols
-    total = sp.csr_matrix((2 * n, n))
+    total = sp.csr_matrix((bq.dim * n, n))
     nmat = bq.rows.matrix(0)
     for r in rows:
         at = sp.vstack([nmat[r.points]] * len(r.components)).tocsr()

@@ -18,7 +18,9 @@ read where they are: the points of the second follow those of the first, and not
 copied into one list. The transposed entries and the point of each entry are int32 (half of
 int64's bytes, the largest arrays of the assembly after the rows) while they fit.
 
-B(g) of a gradient g = (g_x, g_y) is the Voigt strain matrix [[g_x, 0], [0, g_y], [g_y, g_x]].
+B(g) of a gradient g = (g_x, g_y) is the Voigt strain matrix [[g_x, 0], [0, g_y], [g_y, g_x]];
+in 3-D, with g = (g_x, g_y, g_z) and the Voigt order (xx, yy, zz, yz, xz, xy) of engineering
+shears, B(g) = [[g_x, 0, 0], [0, g_y, 0], [0, 0, g_z], [0, g_z, g_y], [g_z, 0, g_x], [g_y, g_x, 0]].
 """
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -125,6 +127,45 @@ def _elastic_fill(ptr_a, idx_a, grad_a, ptr_b, idx_b, grad_b, point_of, t_ptr, t
 
 
 @numba.njit(parallel=True, cache=True)
+def _elastic_fill_3d(ptr_a, idx_a, grad_a, ptr_b, idx_b, grad_b, point_of, t_ptr, t_entry, weight, d, per_point,
+                     num_nodes, nchunks, node_ptr, out_idx, out_data):
+    """The 3 x 3 blocks sum_q B_I^T w_q D_q B_J of K's rows (interleaved unknowns, 3-D Voigt)."""
+    chunk = (num_nodes + nchunks - 1) // nchunks
+    for c in numba.prange(nchunks):
+        stamp = np.full(num_nodes, -1, np.int64)
+        slot = np.empty(num_nodes, np.int64)
+        t = np.empty((3, 6))
+        for i in range(c * chunk, min(num_nodes, (c + 1) * chunk)):
+            width = node_ptr[i + 1] - node_ptr[i]
+            first = 9 * node_ptr[i]
+            cols = _columns(i, width, ptr_a, idx_a, grad_a, ptr_b, idx_b, grad_b, point_of, t_ptr, t_entry, stamp, slot)
+            for s in range(width):
+                for a in range(3):
+                    for b in range(3):
+                        pos = first + 3 * a * width + 3 * s + b
+                        out_idx[pos] = 3 * cols[s] + b
+                        out_data[pos] = 0.0
+            for e_i in range(t_ptr[i], t_ptr[i + 1]):
+                q, ptr, idx, grad, off, gi, pe = _term(e_i, t_entry, point_of, ptr_a, idx_a, grad_a, ptr_b, idx_b,
+                                                       grad_b)
+                # t = B_I^T (w D): 3 x 6.
+                m = d[q] if per_point else d[0]
+                gx, gy, gz, w = gi[pe, 0], gi[pe, 1], gi[pe, 2], weight[q]
+                for s in range(6):
+                    t[0, s] = w * (gx * m[0, s] + gz * m[4, s] + gy * m[5, s])
+                    t[1, s] = w * (gy * m[1, s] + gz * m[3, s] + gx * m[5, s])
+                    t[2, s] = w * (gz * m[2, s] + gy * m[3, s] + gx * m[4, s])
+                for e in range(ptr[off], ptr[off + 1]):
+                    hx, hy, hz = grad[e, 0], grad[e, 1], grad[e, 2]
+                    base = first + 3 * slot[idx[e]]
+                    for a in range(3):
+                        row = base + 3 * a * width
+                        out_data[row] += t[a, 0] * hx + t[a, 4] * hz + t[a, 5] * hy
+                        out_data[row + 1] += t[a, 1] * hy + t[a, 3] * hz + t[a, 5] * hx
+                        out_data[row + 2] += t[a, 2] * hz + t[a, 3] * hy + t[a, 4] * hx
+
+
+@numba.njit(parallel=True, cache=True)
 def _scalar_fill(ptr_a, idx_a, val_a, ptr_b, idx_b, val_b, point_of, t_ptr, t_entry, weight, metric, per_point,
                  num_nodes, nchunks, node_ptr, out_idx, out_data):
     """The entries sum_q w_q a_I(q)^T M_q a_J(q) of the rows of a one-field matrix."""
@@ -202,28 +243,35 @@ def _points(rows: SparseRows | Sequence[SparseRows]) -> _Points:
 
 
 def elastic_stiffness(rows: SparseRows | Sequence[SparseRows], weights: np.ndarray, d: np.ndarray) -> sp.csr_matrix:
-    """K = sum_q w_q B_q^T D_q B_q, shape ``(2 n, 2 n)`` over interleaved unknowns, sorted indices.
+    """K = sum_q w_q B_q^T D_q B_q, shape ``(g n, g n)`` over interleaved unknowns, sorted indices
+    (g = 2, or 3 for gradient rows of 3 components).
 
     Args:
-        rows: Gradient rows grad N_I(x_q), 2 components, shape ``(m, n)``; or a list of such
+        rows: Gradient rows grad N_I(x_q), g components, shape ``(m, n)``; or a list of such
             rows over the same n nodes, whose points follow each other (m = their sum).
-        weights: w_q, shape ``(m,)`` [m^2].
-        d: D [Pa], shape ``(3, 3)`` or one per point ``(m, 3, 3)``.
+        weights: w_q, shape ``(m,)`` [m^2, or m^3 in 3-D].
+        d: D [Pa] in Voigt form, shape ``(v, v)`` or one per point ``(m, v, v)``: v = 3 in 2-D,
+            6 in 3-D.
     """
     pts = _points(rows)
     n = pts.num_nodes
+    g = pts.a.num_components
+    v = 3 if g == 2 else 6
+    fill = _elastic_fill if g == 2 else _elastic_fill_3d
     d = np.ascontiguousarray(d, dtype=np.float64)
+    if d.shape[-2:] != (v, v):
+        raise ValueError(f"D of shape {d.shape} for gradient rows of {g} components; give ({v}, {v}) Voigt matrices")
     per_point = d.ndim == 3
     node_ptr = pts.pattern()
-    out_idx = np.empty(4 * node_ptr[-1], np.int32)
-    out_data = np.empty(4 * node_ptr[-1])
-    _elastic_fill(*pts.rows, pts.point_of, pts.t_ptr, pts.t_entry, np.ascontiguousarray(weights, dtype=np.float64),
-                  d if per_point else d.reshape(1, 3, 3), per_point, n, work_items(n), node_ptr, out_idx, out_data)
-    indptr = np.empty(2 * n + 1, np.int64)
-    indptr[0:-1:2] = 4 * node_ptr[:-1]
-    indptr[1::2] = 4 * node_ptr[:-1] + 2 * np.diff(node_ptr)
-    indptr[-1] = 4 * node_ptr[-1]
-    k = sp.csr_matrix((out_data, out_idx, indptr), shape=(2 * n, 2 * n))
+    out_idx = np.empty(g * g * node_ptr[-1], np.int32)
+    out_data = np.empty(g * g * node_ptr[-1])
+    fill(*pts.rows, pts.point_of, pts.t_ptr, pts.t_entry, np.ascontiguousarray(weights, dtype=np.float64),
+         d if per_point else d.reshape(1, v, v), per_point, n, work_items(n), node_ptr, out_idx, out_data)
+    indptr = np.empty(g * n + 1, np.int64)
+    for a in range(g):
+        indptr[a:-1:g] = g * g * node_ptr[:-1] + a * g * np.diff(node_ptr)
+    indptr[-1] = g * g * node_ptr[-1]
+    k = sp.csr_matrix((out_data, out_idx, indptr), shape=(g * n, g * n))
     k.has_sorted_indices = True
     return k
 

@@ -2,7 +2,8 @@
 ``rkfx.assembly.galerkin``).
 
 Degrees of freedom of vector fields are interleaved per node: (u_x0, u_y0, u_x1, ...).
-Strains use Voigt order (eps_xx, eps_yy, gamma_xy).
+Strains use Voigt order (eps_xx, eps_yy, gamma_xy); in 3-D (gradient rows of three components)
+(eps_xx, eps_yy, eps_zz, gamma_yz, gamma_xz, gamma_xy).
 """
 import numba
 import numpy as np
@@ -14,16 +15,29 @@ from rkfx.integration.quadrature import Quadrature
 from rkfx.approximation.sparse_rows import SparseRows
 
 
+# (Voigt row, displacement component, gradient component) of the entries of B(g).
+_STRAIN_ENTRIES = {2: ((0, 0, 0), (1, 1, 1), (2, 0, 1), (2, 1, 0)),
+                   3: ((0, 0, 0), (1, 1, 1), (2, 2, 2), (3, 1, 2), (3, 2, 1), (4, 0, 2), (4, 2, 0), (5, 0, 1),
+                       (5, 1, 0))}
+
+
+def voigt_size(dim: int) -> int:
+    """Components of a symmetric tensor in Voigt form: 3 in 2-D, 6 in 3-D."""
+    return 3 if dim == 2 else 6
+
+
 def strain_matrix(grad: SparseRows) -> sp.csr_matrix:
-    """B with rows (eps_xx, eps_yy, gamma_xy) per point, shape ``(3 m, 2 n)``."""
-    m, n = grad.num_rows, grad.num_cols
+    """B with the Voigt strain rows per point, shape ``(v m, g n)``: v = 3, g = 2 for 2-D
+    gradient rows, v = 6, g = 3 for 3-D ones (see the module docstring for the order)."""
+    m, n, g = grad.num_rows, grad.num_cols, grad.num_components
+    v = voigt_size(g)
     row = np.repeat(np.arange(m), np.diff(grad.indptr))
-    gx, gy = grad.data[:, 0], grad.data[:, 1]
-    col = 2 * grad.indices.astype(np.int64)
-    rows = np.concatenate([3 * row, 3 * row + 1, 3 * row + 2, 3 * row + 2])
-    cols = np.concatenate([col, col + 1, col, col + 1])
-    vals = np.concatenate([gx, gy, gy, gx])
-    return sp.csr_matrix((vals, (rows, cols)), shape=(3 * m, 2 * n))
+    col = g * grad.indices.astype(np.int64)
+    entries = _STRAIN_ENTRIES[g]
+    rows = np.concatenate([v * row + s for s, _, _ in entries])
+    cols = np.concatenate([col + c for _, c, _ in entries])
+    vals = np.concatenate([grad.data[:, k] for _, _, k in entries])
+    return sp.csr_matrix((vals, (rows, cols)), shape=(v * m, g * n))
 
 
 def block_diagonal(blocks: np.ndarray) -> sp.csr_matrix:
@@ -45,18 +59,20 @@ def _per_quadrature(c, quadratures: list[Quadrature]) -> list:
 
 
 def stiffness(quadratures: list[Quadrature], d) -> sp.csr_matrix:
-    """Elastic stiffness ``sum_q w_q B_q^T D B_q`` (eqs. 3.32 and 3.56), shape ``(2 n, 2 n)``.
+    """Elastic stiffness ``sum_q w_q B_q^T D B_q`` (eqs. 3.32 and 3.56), shape ``(g n, g n)``
+    for gradient rows of g = 2 or 3 components.
 
-    ``d``: one ``(3, 3)`` matrix [Pa], or a list with a ``(3, 3)`` or ``(m_q, 3, 3)`` array per
-    quadrature (a stiffness per point, e.g. degraded by damage).
+    ``d``: one ``(v, v)`` Voigt matrix [Pa] (v = 3 in 2-D, 6 in 3-D), or a list with a ``(v, v)``
+    or ``(m_q, v, v)`` array per quadrature (a stiffness per point, e.g. degraded by damage).
     """
     ds = [np.asarray(dq, float) for dq in _per_quadrature(d, quadratures)]
     if len(quadratures) == 1:
         return elastic_stiffness(quadratures[0].gradients, quadratures[0].weights, ds[0])
     # One pass over all the points (cell and subcell rows, read where they are): no sum of
     # whole matrices, no copy of the rows into one list.
-    same = all(dq.shape == (3, 3) and np.array_equal(dq, ds[0]) for dq in ds)
-    d_all = ds[0] if same else np.concatenate([np.broadcast_to(dq, (len(q.weights), 3, 3))
+    v = ds[0].shape[-1]
+    same = all(dq.shape == (v, v) and np.array_equal(dq, ds[0]) for dq in ds)
+    d_all = ds[0] if same else np.concatenate([np.broadcast_to(dq, (len(q.weights), v, v))
                                                for q, dq in zip(quadratures, ds)])
     return elastic_stiffness([q.gradients for q in quadratures], np.concatenate([q.weights for q in quadratures]),
                              d_all)
@@ -98,16 +114,17 @@ def laplacian(quadratures: list[Quadrature], k=1.0) -> sp.csr_matrix:
     """Diffusion matrix ``sum_q w_q (grad N)^T k grad N`` (eqs. 3.35 and 3.59), shape ``(n, n)``,
     compiled (``rkfx.assembly.galerkin.scalar_form``).
 
-    ``k``: a scalar or ``(2, 2)`` tensor, or a list with a ``(m_q,)`` or ``(m_q, 2, 2)`` array
-    per quadrature (an isotropic or anisotropic permeability per point).
+    ``k``: a scalar or ``(g, g)`` tensor (g = 2, or 3 in 3-D), or a list with a ``(m_q,)`` or
+    ``(m_q, g, g)`` array per quadrature (an isotropic or anisotropic permeability per point).
     """
     metrics = []
+    g = quadratures[0].gradients.num_components
     for q, kq in zip(quadratures, _per_quadrature(k, quadratures)):
         kq = np.asarray(kq, float)
         m = len(q.weights)
         if kq.ndim == 0 or kq.shape == (m,):
-            kq = (kq.reshape(-1, 1, 1) if kq.ndim else kq) * np.eye(2)
-        metrics.append(np.broadcast_to(kq, (m, 2, 2)) if kq.ndim == 3 else kq)
+            kq = (kq.reshape(-1, 1, 1) if kq.ndim else kq) * np.eye(g)
+        metrics.append(np.broadcast_to(kq, (m, g, g)) if kq.ndim == 3 else kq)
     a = _form([q.gradients for q in quadratures], quadratures, metrics)
     a.eliminate_zeros()  # as scipy's sums did (no entries that are exactly zero for the solvers)
     return a

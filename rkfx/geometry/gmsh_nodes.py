@@ -1,8 +1,9 @@
 """Particles from gmsh geometry: a ``.geo`` file or a model built with the gmsh Python API.
 
 The 2-D mesh's vertices become the nodes and its triangles the background triangulation of
-the nodal domains; 1-D physical groups name the boundary parts. Import this module only
-where gmsh is installed (``pip install rkfx[geometry]``).
+the nodal domains; 1-D physical groups name the boundary parts. In 3-D (``from_gmsh_3d``) the
+tetrahedra's vertices become the nodes and 2-D physical groups name the boundary parts.
+Import this module only where gmsh is installed (``pip install rkfx[geometry]``).
 """
 import re
 from collections.abc import Iterator
@@ -13,6 +14,7 @@ import numpy as np
 
 from rkfx.errors import InputError
 from rkfx.geometry.particles import Particles, particles
+from rkfx.geometry.particles3d import Particles3D, particles3d
 
 
 @contextmanager
@@ -44,12 +46,25 @@ def from_gmsh(model=None, comm=None) -> Particles:
         comm: MPI communicator. The mesh is read on rank 0 and broadcast, so every rank holds
             the same node set.
     """
+    x, tri, edges = _on_rank_zero(lambda: _read(model), comm)
+    return particles(x, tri, edges)
+
+
+def _on_rank_zero(read, comm):
+    """``read()`` on rank 0 and its result broadcast to every rank; an ``InputError`` it raises
+    is raised on every rank (the others would otherwise wait in the broadcast)."""
     rank = comm.rank if comm is not None else 0
-    data = _read(model) if rank == 0 else None
+    data = None
+    if rank == 0:
+        try:
+            data = read()
+        except InputError as error:
+            data = error
     if comm is not None and comm.size > 1:
         data = comm.bcast(data, root=0)
-    x, tri, edges = data
-    return particles(x, tri, edges)
+    if isinstance(data, InputError):
+        raise data
+    return data
 
 
 def _read(model):
@@ -93,6 +108,75 @@ def _read(model):
     return x[used], renum[tri], {k: renum[v] for k, v in edges.items()}
 
 
+def from_gmsh_3d(model=None, comm=None) -> Particles3D:
+    """Particles3D from the current 3-D mesh of a gmsh model (linear tetrahedra).
+
+    The tetrahedra of the model's 3-D physical groups (of all its volumes if it has none) are
+    the tetrahedralization; nodes in no tetrahedron are dropped and the rest renumbered in
+    gmsh's order. Each 2-D physical group names a boundary part (its triangles must lie on the
+    solid's boundary).
+
+    Args:
+        model: ``gmsh.model``, already meshed in 3-D; default the current model.
+        comm: MPI communicator. The mesh is read on rank 0 and broadcast, so every rank holds
+            the same node set.
+
+    Raises:
+        InputError: The model has no 3-D mesh, is meshed with other elements than linear
+            tetrahedra (and triangles on the named faces), or fails ``particles3d``'s checks.
+    """
+    x, tets, faces = _on_rank_zero(lambda: _read_3d(model), comm)
+    return particles3d(x, tets, faces)
+
+
+def _read_3d(model):
+    import gmsh  # noqa: PLC0415
+
+    model = model or gmsh.model
+    tags, coords, _ = model.mesh.getNodes()
+    if len(tags) == 0:
+        raise InputError("the gmsh model has no mesh; call gmsh.model.mesh.generate(3) first")
+    index = np.full(int(tags.max()) + 1, -1, np.int64)
+    index[tags.astype(np.int64)] = np.arange(len(tags))
+    x = coords.reshape(-1, 3)
+    groups3 = model.getPhysicalGroups(3)
+    volumes = sorted({e for _, g in groups3 for e in model.getEntitiesForPhysicalGroup(3, g)}) if groups3 \
+        else [e for _, e in model.getEntities(3)]
+    tets = []
+    for v in volumes:
+        for t, nd in zip(*model.mesh.getElements(3, v)[::2]):
+            if t != 4:
+                name = model.mesh.getElementProperties(t)[0]
+                raise InputError(f"volume {v} has gmsh element type {t} ({name}); rkfx needs linear tetrahedra "
+                                 "(set Mesh.ElementOrder = 1, Mesh.RecombineAll = 0 and no Mesh.SubdivisionAlgorithm "
+                                 "before gmsh.model.mesh.generate(3))")
+            tets.append(index[nd.astype(np.int64)].reshape(-1, 4))
+    if not tets or sum(len(t) for t in tets) == 0:
+        raise InputError("the gmsh model has no 3-D mesh (no tetrahedra); call gmsh.model.mesh.generate(3) first")
+    tets = np.concatenate(tets)
+    faces = {}
+    for dim, g in model.getPhysicalGroups(2):
+        name = model.getPhysicalName(dim, g) or f"boundary_{g}"
+        part = []
+        for s in model.getEntitiesForPhysicalGroup(dim, g):
+            for t, nd in zip(*model.mesh.getElements(2, s)[::2]):
+                if t != 2:
+                    raise InputError(f"surface {s} of boundary {name!r} has gmsh element type {t}; rkfx needs "
+                                     "linear triangles on the boundary (Mesh.ElementOrder = 1, Mesh.RecombineAll = 0)")
+                part.append(index[nd.astype(np.int64)].reshape(-1, 3))
+        faces[name] = np.concatenate(part) if part else np.empty((0, 3), np.int64)
+    # Keep only the nodes of the tetrahedra (gmsh keeps geometry points and the nodes of
+    # lower-dimensional entities outside the solid).
+    used = np.unique(tets)
+    renum = np.full(len(x), -1, np.int64)
+    renum[used] = np.arange(len(used))
+    for name, f in faces.items():
+        if f.size and (renum[f] < 0).any():
+            raise InputError(f"boundary {name!r} has triangles with nodes in no tetrahedron; "
+                             "name only faces of the meshed solid")
+    return x[used], renum[tets], {k: renum[v] for k, v in faces.items()}
+
+
 def from_geo(path: str | Path, mesh_size: float | None = None, comm=None) -> Particles:
     """Particles from a gmsh ``.geo`` file, meshed in 2-D.
 
@@ -108,19 +192,7 @@ def from_geo(path: str | Path, mesh_size: float | None = None, comm=None) -> Par
     """
     path = Path(path)
     _check_geo_text(path)
-    rank = comm.rank if comm is not None else 0
-    data = None
-    if rank == 0:
-        try:
-            data = _mesh_geo(path, mesh_size)
-        except InputError as error:
-            # Handed to every rank, so the others raise too instead of waiting in bcast.
-            data = error
-    if comm is not None and comm.size > 1:
-        data = comm.bcast(data, root=0)
-    if isinstance(data, InputError):
-        raise data
-    return particles(*data)
+    return particles(*_on_rank_zero(lambda: _mesh_geo(path, mesh_size), comm))
 
 
 def _check_geo_text(path: Path) -> None:

@@ -15,8 +15,31 @@ from scipy.spatial import Delaunay
 from rkfx.errors import InputError, point_str
 
 
+class NamedBoundary:
+    """Boundary parts by name, for particle sets with ``boundary_names`` (name -> tag),
+    ``boundary_tags`` and the node tuples of their boundary elements ``boundary_elements``
+    (edges in 2-D, triangles in 3-D)."""
+
+    boundary_names: dict[str, int]
+    boundary_tags: np.ndarray
+
+    def tag(self, name: str) -> int:
+        """Tag of a named boundary part."""
+        if name not in self.boundary_names:
+            raise InputError(f"unknown boundary {name!r}; this geometry names {sorted(self.boundary_names)}")
+        return self.boundary_names[name]
+
+    def boundary_nodes(self, *names: str) -> np.ndarray:
+        """Sorted indices of the nodes on the named boundary parts (all parts if none named)."""
+        if names:
+            mask = np.isin(self.boundary_tags, [self.tag(n) for n in names])
+        else:
+            mask = np.ones(len(self.boundary_tags), bool)
+        return np.unique(self.boundary_elements[mask])
+
+
 @dataclass(frozen=True)
-class Particles:
+class Particles(NamedBoundary):
     """Nodes with spacing, a conforming triangulation and named boundary parts.
 
     Attributes:
@@ -44,19 +67,9 @@ class Particles:
     def num_nodes(self) -> int:
         return len(self.x)
 
-    def tag(self, name: str) -> int:
-        """Tag of a named boundary part."""
-        if name not in self.boundary_names:
-            raise InputError(f"unknown boundary {name!r}; this geometry names {sorted(self.boundary_names)}")
-        return self.boundary_names[name]
-
-    def boundary_nodes(self, *names: str) -> np.ndarray:
-        """Sorted indices of the nodes on the named boundary parts (all parts if none named)."""
-        if names:
-            mask = np.isin(self.boundary_tags, [self.tag(n) for n in names])
-        else:
-            mask = np.ones(len(self.boundary_tags), bool)
-        return np.unique(self.boundary_edges[mask])
+    @property
+    def boundary_elements(self) -> np.ndarray:
+        return self.boundary_edges
 
     def area(self) -> float:
         """Area of the triangulated domain [m^2]."""

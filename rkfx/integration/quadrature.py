@@ -16,6 +16,7 @@ import numba
 import numpy as np
 
 from rkfx.errors import InputError
+from rkfx.geometry.cells import cell_measures
 from rkfx.geometry.nodal_domains import NodalDomains
 from rkfx.geometry.particles import Particles
 from rkfx.approximation.shape_functions import RKApproximation, evaluate
@@ -106,11 +107,13 @@ POINTS_PER_BLOCK = 250_000
 
 
 def selected_cells(domains: NodalDomains, nodes: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-    """The cells ``nodes`` (all when ``None``) and their subcells, in index order."""
+    """The cells ``nodes`` (all when ``None``) and their subcells, in index order (2-D domains
+    or 3-D ``NodalCells3D``)."""
+    cell, subcell = cell_measures(domains)
     if nodes is None:
-        return np.arange(len(domains.area)), np.arange(len(domains.subcell_area))
+        return np.arange(len(cell)), np.arange(len(subcell))
     nodes = np.asarray(nodes, dtype=np.int64)
-    mine = np.zeros(len(domains.area), bool)
+    mine = np.zeros(len(cell), bool)
     mine[nodes] = True
     return nodes, np.flatnonzero(mine[domains.subcell_node])
 

@@ -23,13 +23,13 @@ SOLVERS = ("mumps", "gmres-ilu", "cg-gamg", "fieldsplit")
 
 @dataclass(frozen=True)
 class DisplacementSplit:
-    """The block structure that the ``fieldsplit`` solver preconditions: the first 2 n unknowns
-    are the displacements, interleaved per node; the others (pressures, multipliers of
-    collocated conditions) form the second block.
+    """The block structure that the ``fieldsplit`` solver preconditions: the first g n unknowns
+    (g = 2 or 3) are the displacements, interleaved per node; the others (pressures, multipliers
+    of collocated conditions) form the second block.
 
     Attributes:
-        coordinates: The n nodes, shape ``(n, 2)`` [m]: their rigid-body modes are the near
-            null space of the displacement block's multigrid.
+        coordinates: The n nodes, shape ``(n, 2)`` or ``(n, 3)`` [m]: their rigid-body modes are
+            the near null space of the displacement block's multigrid.
         fixed_stress: The fixed-stress estimate of the coupling's share of the pressure Schur
             complement, alpha^2 / K_dr int N_I (K_dr the drained bulk modulus), per pressure
             unknown, shape ``(n,)``; the second block's own diagonal block, so shifted (away
@@ -41,9 +41,14 @@ class DisplacementSplit:
     fixed_stress: np.ndarray | None = None
 
     @property
+    def dim(self) -> int:
+        """Displacement components per node, 2 or 3."""
+        return self.coordinates.shape[1]
+
+    @property
     def size(self) -> int:
-        """The displacement unknowns, 2 n."""
-        return 2 * len(self.coordinates)
+        """The displacement unknowns, g n (g = 2, or 3 for coordinates of shape ``(n, 3)``)."""
+        return self.coordinates.shape[1] * len(self.coordinates)
 
 
 class _ScipyLU:

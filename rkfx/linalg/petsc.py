@@ -44,18 +44,18 @@ class SolverDiverged(SolverError):
     """A PETSc linear solve did not converge."""
 
 
-def to_petsc_mat(a: sp.spmatrix, comm=MPI.COMM_WORLD, even_below: int = 0) -> PETSc.Mat:
+def to_petsc_mat(a: sp.spmatrix, comm=MPI.COMM_WORLD, even_below: int = 0, block: int = 2) -> PETSc.Mat:
     """Distributed AIJ matrix from a global scipy sparse matrix held on every rank.
 
-    ``even_below``: no rank's rows start at an odd row below this one (the interleaved
-    displacement pairs of the first ``even_below`` rows stay on one rank)."""
+    ``even_below``: below this row, every rank's rows start at a multiple of ``block`` (the
+    interleaved displacements of a node, 2 or 3 of them, stay on one rank)."""
     a = _sorted_csr(a)
     n_rows, n_cols = a.shape
     mat = PETSc.Mat().create(comm=comm)
     local = PETSc.DECIDE
     if even_below and comm.size > 1:
         cuts = [n_rows * r // comm.size for r in range(comm.size + 1)]
-        cuts = [c + (c % 2 if c < even_below else 0) for c in cuts]
+        cuts = [c + (-c % block if c < even_below else 0) for c in cuts]
         local = cuts[comm.rank + 1] - cuts[comm.rank]
     mat.setSizes(((local, n_rows), (local, n_cols)))
     mat.setType(PETSc.Mat.Type.AIJ)
@@ -128,9 +128,9 @@ def make_ksp(mat: PETSc.Mat, solver: str = "mumps", rtol: float | None = None, p
     with pivoting (its symmetric indefinite mode), from the upper triangle only.
 
     ``mumps_icntl`` sets further MUMPS controls, e.g. ``{7: 2}`` for the AMF ordering.
-    ``coordinates`` (cg-gamg on a 2-D displacement system, unknowns interleaved per node): the
-    coordinates of the nodes of this rank's rows, shape ``(local_rows / 2, 2)``; GAMG then
-    aggregates node blocks and keeps the three rigid-body modes on every level. ``rtol``: the
+    ``coordinates`` (cg-gamg on a displacement system, unknowns interleaved per node): the
+    coordinates of the nodes of this rank's rows, shape ``(local_rows / g, g)`` for g = 2 or 3;
+    GAMG then aggregates node blocks and keeps the rigid-body modes (3 or 6) on every level. ``rtol``: the
     relative residual to stop at (default ``RTOL[solver]``). PETSc options given with
     ``-rkfx_...`` on the command line or in ``PETSC_OPTIONS`` refine the choice, e.g.
     ``-rkfx_ksp_rtol 1e-10`` or ``-rkfx_pc_gamg_threshold 0.05``.
@@ -199,18 +199,18 @@ def _field_split(ksp: PETSc.KSP, mat: PETSc.Mat, split: DisplacementSplit, rtol:
     refine either block."""
     comm = mat.getComm()
     lo, hi = mat.getOwnershipRange()
-    n_u = split.size
+    n_u, g = split.size, split.dim
     u_lo, u_hi = min(lo, n_u), min(hi, n_u)
-    if u_lo % 2:
-        raise InputError("fieldsplit: a rank's rows begin inside a node's displacement pair; build the matrix "
-                         "with to_petsc_mat(..., even_below=2 n)")
+    if u_lo % g:
+        raise InputError("fieldsplit: a rank's rows begin inside a node's displacement components; build the "
+                         "matrix with to_petsc_mat(..., even_below=g n, block=g)")
     is_u = PETSc.IS().createStride(u_hi - u_lo, u_lo, 1, comm=comm)
     p_lo = min(max(lo, n_u), hi)
     is_p = PETSc.IS().createStride(hi - p_lo, p_lo, 1, comm=comm)
-    x = np.ascontiguousarray(split.coordinates[u_lo // 2:u_hi // 2], dtype=PETSc.ScalarType)
-    modes = PETSc.Vec().createMPI((u_hi - u_lo, PETSc.DECIDE), bsize=2, comm=comm)
+    x = np.ascontiguousarray(split.coordinates[u_lo // g:u_hi // g], dtype=PETSc.ScalarType)
+    modes = PETSc.Vec().createMPI((u_hi - u_lo, PETSc.DECIDE), bsize=g, comm=comm)
     modes.array[:] = x.ravel()
-    is_u.setBlockSize(2)
+    is_u.setBlockSize(g)
     is_u.compose("nearnullspace", PETSc.NullSpace().createRigidBody(modes))
     modes.destroy()
     ksp.setType("gmres")
@@ -262,16 +262,17 @@ def _block_mat(block: sp.csr_matrix, rows: PETSc.IS, first: int, comm) -> PETSc.
 
 
 def _rigid_body_modes(mat: PETSc.Mat, coordinates: np.ndarray) -> None:
-    """Give ``mat`` (interleaved 2-D displacements) the rigid-body modes of its nodes as its near
-    null space, for smoothed aggregation."""
-    x = np.ascontiguousarray(coordinates, dtype=PETSc.ScalarType).reshape(-1, 2)
+    """Give ``mat`` (interleaved 2-D or 3-D displacements, as ``coordinates`` has 2 or 3 columns)
+    the rigid-body modes of its nodes (3 or 6) as its near null space, for smoothed aggregation."""
+    g = np.shape(coordinates)[-1]
+    x = np.ascontiguousarray(coordinates, dtype=PETSc.ScalarType).reshape(-1, g)
     lo, hi = mat.getOwnershipRange()
-    if 2 * len(x) != hi - lo:
+    if g * len(x) != hi - lo:
         raise InputError(f"coordinates of {len(x)} nodes for {hi - lo} rows; give the nodes of this rank's rows "
-                         "(2 unknowns per node, no multiplier rows)")
-    vec = PETSc.Vec().createMPI((2 * len(x), PETSc.DECIDE), bsize=2, comm=mat.getComm())
+                         f"({g} unknowns per node, no multiplier rows)")
+    vec = PETSc.Vec().createMPI((g * len(x), PETSc.DECIDE), bsize=g, comm=mat.getComm())
     vec.array[:] = x.ravel()
-    mat.setBlockSize(2)
+    mat.setBlockSize(g)
     mat.setNearNullSpace(PETSc.NullSpace().createRigidBody(vec))
     vec.destroy()
 
@@ -295,7 +296,8 @@ class LinearSolver:
             self.mat = owned_rows_mat(a, comm)
         else:
             self.pattern = (a.shape, a.indptr.copy(), a.indices.copy())
-            self.mat = to_petsc_mat(a, comm, even_below=0 if split is None else split.size)
+            self.mat = to_petsc_mat(a, comm, even_below=0 if split is None else split.size,
+                                    block=2 if split is None else split.dim)
         # symmetric=True: L D L^T for a matrix that is (``is_symmetric``), whole on every rank.
         # Not the default: on the saddle points of the transformation method (zero diagonal
         # block) MUMPS's pivoting L D L^T took 36.9 s where LU took 4.2 s (Sneddon, 99,844

@@ -91,6 +91,20 @@ class ElasticMaterial:
         lam, mu = self.lame
         return np.array([[lam + 2 * mu, lam, 0.0], [lam, lam + 2 * mu, 0.0], [0.0, 0.0, mu]])
 
+    def D3(self) -> np.ndarray:
+        """Elasticity matrix of the 3-D solid in Voigt form (eps_xx, eps_yy, eps_zz, gamma_yz, gamma_xz,
+        gamma_xy), shape ``(6, 6)`` [Pa] (``plane`` plays no part)."""
+        lam, mu = self.lame_lambda, self.shear_modulus
+        d = np.zeros((6, 6))
+        d[:3, :3] = lam
+        d[[0, 1, 2], [0, 1, 2]] = lam + 2 * mu
+        d[[3, 4, 5], [3, 4, 5]] = mu
+        return d
+
+    def voigt(self, dim: int) -> np.ndarray:
+        """D of the 2-D law (``dim`` 2) or of the 3-D solid (``dim`` 3) [Pa]."""
+        return self.D() if dim == 2 else self.D3()
+
 
 def principal_direction(voigt: np.ndarray, kind: str = "stress") -> np.ndarray:
     """Unit direction of the major principal value of Voigt tensors: the crack normal n_L.
@@ -117,7 +131,13 @@ def principal_direction(voigt: np.ndarray, kind: str = "stress") -> np.ndarray:
 
 
 def traction_operator(normal: np.ndarray) -> np.ndarray:
-    """Maps Voigt stress to traction t = sigma n, shape ``(m, 2, 3)`` for normals ``(m, 2)``."""
+    """Maps Voigt stress to traction t = sigma n, shape ``(m, 2, 3)`` for normals ``(m, 2)``, or
+    ``(m, 3, 6)`` for normals ``(m, 3)`` (Voigt order xx, yy, zz, yz, xz, xy)."""
+    if normal.shape[1] == 3:
+        nx, ny, nz = normal[:, 0], normal[:, 1], normal[:, 2]
+        z = np.zeros_like(nx)
+        return np.stack([np.stack([nx, z, z, z, nz, ny], -1), np.stack([z, ny, z, nz, z, nx], -1),
+                         np.stack([z, z, nz, ny, nx, z], -1)], axis=1)
     nx, ny = normal[:, 0], normal[:, 1]
     z = np.zeros_like(nx)
     return np.stack([np.stack([nx, z, ny], -1), np.stack([z, ny, nx], -1)], axis=1)

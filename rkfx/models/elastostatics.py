@@ -1,7 +1,12 @@
-"""Plane-strain elastostatics with RK shape functions: assemble, constrain, solve through PETSc.
+"""Elastostatics with RK shape functions, in 2-D (plane strain or stress) and 3-D: assemble,
+constrain, solve through PETSc.
 
-The boundary conditions are those of ``rkfx.conditions``: ``Displacement`` (imposed by Nitsche's
-method or the transformation method, ``rkfx.assembly.boundary``) and ``Traction``.
+One driver, ``solve_elasticity``, for both dimensions: 2-D particles (``rkfx.geometry.particles``)
+take the median-dual cells and the rules of ``rkfx.integration.quadrature``, 3-D particles
+(``rkfx.geometry.particles3d``) the cells of ``rkfx.geometry.nodal_cells3d`` and the rules of
+``rkfx.integration.nodal_rules3d``; ``solve_plane_strain`` is the 2-D entry. The boundary
+conditions are those of ``rkfx.conditions``: ``Displacement`` (imposed by Nitsche's method or the
+transformation method, ``rkfx.assembly.boundary``) and ``Traction``.
 """
 import time
 from collections.abc import Callable, Sequence
@@ -16,9 +21,11 @@ from rkfx.conditions import Condition, Displacement, Traction, split
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.linalg.linear_solver import SOLVERS, linear_solver
 from rkfx.errors import InputError
-from rkfx.geometry.nodal_domains import NodalDomains, nodal_domains
+from rkfx.geometry.cells import nodal_cells
+from rkfx.geometry.nodal_domains import NodalDomains
 from rkfx.assembly.operators import add_into, load_vector, stiffness
 from rkfx.geometry.particles import Particles
+from rkfx.integration.nodal_rules3d import RULES_3D, integration_rules_3d
 from rkfx.integration.quadrature import NODAL_RULES, integration_rules, scni, subcell_rule
 from rkfx.parallel.ownership import numbering
 from rkfx.parallel.partition import rcb
@@ -54,7 +61,8 @@ class ElasticSolution:
 
     Attributes:
         rk: The approximation.
-        coefficients: Nodal coefficients d_I (not nodal values), shape ``(num_nodes, 2)`` [m].
+        coefficients: Nodal coefficients d_I (not nodal values), shape ``(num_nodes, g)`` [m],
+            g = 2 or 3.
         n_dofs: Number of displacement unknowns.
         timings: Wall times of the stages [s].
         linear: The linear solve: ``solver``, its ``iterations`` (1 for a direct solve) and
@@ -68,31 +76,41 @@ class ElasticSolution:
     linear: dict = field(default_factory=dict)
 
     def displacement(self, points: np.ndarray) -> np.ndarray:
-        """u^h at points, shape ``(m, 2)`` [m]."""
+        """u^h at points, shape ``(m, g)`` [m]."""
         return evaluate(self.rk, points).matrix(0) @ self.coefficients
 
     def gradient(self, points: np.ndarray) -> np.ndarray:
-        """Direct gradient of u^h at points, shape ``(m, 2, 2)`` with [i, j] = du_i/dx_j."""
+        """Direct gradient of u^h at points, shape ``(m, g, g)`` with [i, j] = du_i/dx_j."""
         rows = evaluate(self.rk, points, gradients=True)
-        return np.stack([rows.matrix(1) @ self.coefficients, rows.matrix(2) @ self.coefficients], axis=2)
+        return np.stack([rows.matrix(1 + j) @ self.coefficients for j in range(self.rk.dim)], axis=2)
 
 
 def solve_plane_strain(p: Particles, material: ElasticMaterial, conditions: Sequence[Displacement | Traction] = (),
-                       *, body_force: Callable[[np.ndarray], np.ndarray] | None = None,
-                       rule: str = "mscni", bc_method: str = "nitsche", support_factor: float = 1.5,
-                       order: int = 1, nitsche_penalty: float = 100.0, comm=None,
-                       solver: str = "auto", distributed: bool | None = None) -> ElasticSolution:
-    """Solve plane-strain elasticity on ``p``.
+                       **options) -> ElasticSolution:
+    """Solve 2-D elasticity (the material's plane strain or plane stress) on 2-D particles ``p``:
+    ``solve_elasticity`` with its options."""
+    if p.x.shape[1] != 2:
+        raise InputError(f"solve_plane_strain takes 2-D particles; these have {p.x.shape[1]} coordinates: use "
+                         "solve_elasticity")
+    return solve_elasticity(p, material, conditions, **options)
+
+
+def solve_elasticity(p, material: ElasticMaterial, conditions: Sequence[Displacement | Traction] = (),
+                     *, body_force: Callable[[np.ndarray], np.ndarray] | None = None,
+                     rule: str = "mscni", bc_method: str = "nitsche", support_factor: float = 1.5,
+                     order: int = 1, nitsche_penalty: float = 100.0, comm=None,
+                     solver: str = "auto", distributed: bool | None = None, domains=None) -> ElasticSolution:
+    """Solve linear elasticity on ``p``: 2-D (the material's plane strain or stress) or 3-D.
 
     Args:
-        p: Particles with named boundary parts.
+        p: Particles with named boundary parts (``Particles`` or ``Particles3D``).
         material: Elastic constants.
         conditions: The boundary conditions, one list of ``rkfx.conditions.Displacement``
             (prescribed displacements, value(x, t) at t = 0 or a constant) and
             ``rkfx.conditions.Traction`` (value(x, t, n) at t = 0 or a constant vector) on
             named or marked boundary parts; the rest of the boundary is traction-free.
-        body_force: b(x) [N/m^3] for x of shape ``(m, 2)``, returning ``(m, 2)``.
-        rule: Integration rule: ``gauss1|gauss2|gauss4|dni|scni|mscni``.
+        body_force: b(x) [N/m^3] for x of shape ``(m, g)``, returning ``(m, g)``.
+        rule: Integration rule: ``gauss1|gauss2|gauss4|dni|scni|mscni`` (3-D: ``dni|scni|mscni``).
         bc_method: ``transformation`` or ``nitsche``.
         support_factor, order: RK support a_I = c h_I and basis degree.
         nitsche_penalty: Dimensionless Nitsche parameter.
@@ -104,16 +122,21 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, conditions: Sequ
             over the cells of its part of an RCB partition only. ``None`` (default): when
             ``comm`` has more than one rank and the rule is nodal (``scni``, ``mscni``); the
             other rules are assembled whole on every rank, as with ``False``.
+        domains: The nodal cells (default: ``nodal_cells(p)``, the median-dual cells, or in 3-D
+            the box cells of a tensor grid).
     """
     displacements, tractions = _displacements_and_tractions(conditions)
     if bc_method not in BC_METHODS:
         raise InputError(f"unknown bc_method {bc_method!r}; choose one of {', '.join(BC_METHODS)}")
+    g = p.x.shape[1]
+    if g == 3 and rule not in RULES_3D:
+        raise InputError(f"rule {rule!r} is not available in 3-D; choose one of {', '.join(RULES_3D)}")
     if distributed is None:
         distributed = comm is not None and comm.size > 1 and rule in NODAL_RULES
     elif distributed and rule not in NODAL_RULES:
         raise InputError(f"distributed=True needs a nodal rule ({', '.join(NODAL_RULES)}), not {rule!r}; "
                          "choose one, or distributed=False")
-    solver = choose_solver(solver, 2 * p.num_nodes, bc_method, rule)
+    solver = choose_solver(solver, g * p.num_nodes, bc_method, rule)
     times = {}
     t0 = time.perf_counter()
     rk = rk_approximation(p.x, p.spacing, support_factor, order)
@@ -121,15 +144,15 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, conditions: Sequ
                  rule=rule, bc_method=bc_method, nitsche_penalty=nitsche_penalty)
     linear = {"solver": solver}
     if distributed:
-        coefficients = _solve_by_owned_rows(p, rk, terms, comm, solver, times, t0, linear)
-        return ElasticSolution(rk, coefficients, 2 * p.num_nodes, times, linear)
-    domains = nodal_domains(p)
-    k, f, g, gv = elastic_terms(p, rk, domains, **terms)
-    _check_rigid_modes(p, g)
+        coefficients = _solve_by_owned_rows(p, rk, terms, comm, solver, times, t0, linear, domains)
+        return ElasticSolution(rk, coefficients, g * p.num_nodes, times, linear)
+    domains = nodal_cells(p) if domains is None else domains
+    k, f, gm, gv = elastic_terms(p, rk, domains, **terms)
+    _check_rigid_modes(p, gm)
     if bc_method == "nitsche":
         system, rhs = k, f
     else:
-        system = sp.bmat([[k, g.T], [g, None]], format="csr")
+        system = sp.bmat([[k, gm.T], [gm, None]], format="csr")
         rhs = np.concatenate([f, gv])
     times["assemble"] = time.perf_counter() - t0
     t0 = time.perf_counter()
@@ -141,7 +164,8 @@ def solve_plane_strain(p: Particles, material: ElasticMaterial, conditions: Sequ
     linear.update(iterations=ls.iterations, reason=ls.reason)
     ls.destroy()
     times["solve"] = time.perf_counter() - t0
-    return ElasticSolution(rk, x[:2 * p.num_nodes].reshape(-1, 2), 2 * p.num_nodes, times, linear)
+    return ElasticSolution(rk, x[:g * p.num_nodes].reshape(-1, g), g * p.num_nodes, times, linear)
+
 
 
 @ordinary_pages()  # its arrays are temporaries (rkfx.memory)
@@ -150,15 +174,19 @@ def elastic_terms(p: Particles, rk: RKApproximation, domains: NodalDomains, mate
                   body_force: Callable[[np.ndarray], np.ndarray] | None, rule: str, bc_method: str,
                   nitsche_penalty: float, nodes: np.ndarray | None = None
                   ) -> tuple[sp.csr_matrix, np.ndarray, sp.csr_matrix, np.ndarray]:
-    """The stiffness K (2n, 2n) and load f (2n,), with the Nitsche terms for ``nitsche``, and
-    the collocation rows G (k, 2n) and values g (k,) of the displacement conditions.
+    """The stiffness K (g n, g n) and load f (g n,), with the Nitsche terms for ``nitsche``, and
+    the collocation rows G (k, g n) and values g (k,) of the displacement conditions (g = 2 or 3).
 
     ``nodes`` (indices, a nodal rule only) integrates over those nodes' cells and boundary
-    half-segments and collocates at those of them on Gamma_u: a rank's share, whose K and f
-    summed over a partition's parts (and G stacked) are the whole ones.
+    half-segments (facets in 3-D) and collocates at those of them on Gamma_u: a rank's share,
+    whose K and f summed over a partition's parts (and G stacked) are the whole ones.
     """
-    d = material.D()
-    if rule == "mscni":  # its stiffness is the subcell rule's (eps_p = 1; subcell_rule)
+    dim = p.x.shape[1]
+    d = material.voigt(dim)
+    if dim == 3:
+        quads = integration_rules_3d(rule, p, rk, domains, nodes=nodes)
+        k = stiffness(quads, d)
+    elif rule == "mscni":  # its stiffness is the subcell rule's (eps_p = 1; subcell_rule)
         k = stiffness([subcell_rule(rk, domains, nodes=nodes)], d)
         quads = [scni(p, rk, domains, nodes=nodes)] if body_force is not None else []
     else:
@@ -178,8 +206,8 @@ def elastic_terms(p: Particles, rk: RKApproximation, domains: NodalDomains, mate
 
 
 def _solve_by_owned_rows(p: Particles, rk: RKApproximation, terms: dict, comm, solver: str, times: dict,
-                         t0: float, linear: dict) -> np.ndarray:
-    """The coefficients, shape ``(n, 2)``, on every rank, from a system assembled by owned rows.
+                         t0: float, linear: dict, domains=None) -> np.ndarray:
+    """The coefficients, shape ``(n, g)``, on every rank, from a system assembled by owned rows.
 
     The nodes are split by RCB (``rkfx.parallel.partition``); each rank builds the nodal
     domains around its nodes and integrates over its nodes' cells only (``nodal_domains`` and
@@ -191,19 +219,21 @@ def _solve_by_owned_rows(p: Particles, rk: RKApproximation, terms: dict, comm, s
     solve's iterations and stopping reason.
     """
     rank, size = (0, 1) if comm is None else (comm.rank, comm.size)
+    dim = p.x.shape[1]
     part = rcb(p.x, size)
     num = numbering(part, size)
     owned = num.old_of_new[num.ranges[rank]:num.ranges[rank + 1]]
-    k, f, g, gv = elastic_terms(p, rk, nodal_domains(p, nodes=owned), nodes=owned, **terms)
+    cells = nodal_cells(p, nodes=owned) if domains is None else domains
+    k, f, g, gv = elastic_terms(p, rk, cells, nodes=owned, **terms)
     _check_rigid_modes(p, g, comm)
     mine = g.shape[0] if terms["bc_method"] == "transformation" else 0
     multipliers = np.array(comm.allgather(mine) if size > 1 else [mine])
     starts = np.zeros(size + 1, np.int64)
-    np.cumsum(2 * np.diff(num.ranges) + multipliers, out=starts[1:])
+    np.cumsum(dim * np.diff(num.ranges) + multipliers, out=starts[1:])
     # Global unknown of every (node, component) and of this rank's multipliers.
-    first = starts[part] + 2 * (num.new_of_old - num.ranges[part])
-    unknown = np.concatenate([(first[:, None] + np.arange(2)).ravel(),
-                              starts[rank] + 2 * len(owned) + np.arange(mine)])
+    first = starts[part] + dim * (num.new_of_old - num.ranges[part])
+    unknown = np.concatenate([(first[:, None] + np.arange(dim)).ravel(),
+                              starts[rank] + dim * len(owned) + np.arange(mine)])
     if mine:
         k = sp.bmat([[k, g.T], [g, None]], format="csr")
         f = np.concatenate([f, gv])
@@ -224,7 +254,7 @@ def _solve_by_owned_rows(p: Particles, rk: RKApproximation, terms: dict, comm, s
     linear.update(iterations=ls.iterations, reason=ls.reason)
     ls.destroy()
     times["solve"] = time.perf_counter() - t0
-    return x[unknown[:2 * p.num_nodes]].reshape(-1, 2)
+    return x[unknown[:dim * p.num_nodes]].reshape(-1, dim)
 
 
 def _displacements_and_tractions(conditions: Sequence[Condition]) -> tuple[list, list]:
@@ -234,7 +264,7 @@ def _displacements_and_tractions(conditions: Sequence[Condition]) -> tuple[list,
     by_kind = split(conditions)
     other = [c for kind, cs in by_kind.items() if kind not in (Displacement, Traction) for c in cs]
     if other:
-        raise InputError(f"solve_plane_strain takes rkfx.conditions.Displacement and Traction conditions, not "
+        raise InputError(f"solve_elasticity takes rkfx.conditions.Displacement and Traction conditions, not "
                          f"{other[0]!r}; drop it (a Velocity belongs to explicit dynamics: smeared_strain.constraint)")
     return by_kind[Displacement], by_kind[Traction]
 
@@ -247,17 +277,23 @@ def _check_rigid_modes(p: Particles, g: sp.csr_matrix, comm=None) -> None:
     nodal values are exactly the rigid modes; each must violate some constraint row.
     """
     x = p.x - p.x.mean(axis=0)
-    modes = np.zeros((2 * p.num_nodes, 3))
-    modes[0::2, 0] = 1.0
-    modes[1::2, 1] = 1.0
-    modes[0::2, 2], modes[1::2, 2] = -x[:, 1], x[:, 0]
-    seen = g @ modes if g.shape[0] else np.zeros((0, 3))
+    dim = x.shape[1]
+    names = ["x-translation", "y-translation", "z-translation"][:dim]
+    # Rotations about the axes normal to each coordinate plane (i, j): u_i = -x_j, u_j = x_i.
+    planes = [(0, 1)] if dim == 2 else [(1, 2), (0, 2), (0, 1)]
+    names += ["rotation"] if dim == 2 else ["rotation about x", "rotation about y", "rotation about z"]
+    modes = np.zeros((dim * p.num_nodes, len(names)))
+    for c in range(dim):
+        modes[c::dim, c] = 1.0
+    for k, (i, j) in enumerate(planes, start=dim):
+        modes[i::dim, k], modes[j::dim, k] = -x[:, j], x[:, i]
+    seen = g @ modes if g.shape[0] else np.zeros((0, len(names)))
     if comm is not None and comm.size > 1:
         seen = np.vstack(comm.allgather(seen))
     sv = np.linalg.svd(seen, compute_uv=False) if len(seen) else np.zeros(0)
     scale = np.abs(modes).max()
-    if len(sv) < 3 or sv[-1] <= 1e-10 * scale * max(sv[0], 1.0):
-        free = [name for name, k in (("x-translation", 0), ("y-translation", 1), ("rotation", 2))
+    if len(sv) < len(names) or sv[-1] <= 1e-10 * scale * max(sv[0], 1.0):
+        free = [name for k, name in enumerate(names)
                 if not np.any(np.abs(seen[:, k]) > 1e-12 * scale)] or ["a combination of rigid motions"]
         raise InputError(f"the displacement conditions leave {', '.join(free)} free, so the stiffness is "
                          "singular; prescribe more components (e.g. a roller on a second boundary)")

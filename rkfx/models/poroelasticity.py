@@ -15,6 +15,11 @@ ni+fpp     DNI                                     FPP (3.49)-(3.52)
 scni+fpp   SCNI + MSCNI subcells (3.56)-(3.59)     FPP on the same cells (3.60)
 =========  ======================================  ============================
 
+The same model runs in 3-D on ``rkfx.geometry.particles3d.Particles3D``: the cells of
+``rkfx.geometry.nodal_cells3d``, the rules of ``rkfx.integration.nodal_rules3d`` (MSCNI with
+direct gradients at the stabilization points, the seed's 13-point rule on box cells) and the
+characteristic length h = V_L^(1/3) in eps_f.
+
 Each step solves J X = R of eqs. (3.50)-(3.51) with the essential conditions imposed at the
 boundary nodes by collocation (the transformation method; see ``rkfx.assembly.boundary``), which keeps
 prescribed pressures exact however small the time step.
@@ -39,10 +44,12 @@ from rkfx.assembly.boundary import (BC_METHODS, BoundaryQuadrature, Collocation,
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.conditions import Displacement, Flux, Pressure, Traction, values
 from rkfx.errors import InputError
-from rkfx.geometry.nodal_domains import NodalDomains, nodal_domains
+from rkfx.geometry.cells import cell_measures, nodal_cells
+from rkfx.geometry.nodal_domains import NodalDomains
 from rkfx.assembly.operators import laplacian, mass, stiffness
 from rkfx.geometry.particles import Particles
 from rkfx.linalg.linear_solver import DisplacementSplit, Factorizations
+from rkfx.integration.nodal_rules3d import dni_3d, mscni_rules_3d, scni_3d
 from rkfx.integration.quadrature import Quadrature, dni, mscni_rules, scni, selected_cells
 from rkfx.approximation.shape_functions import RKApproximation, evaluate, rk_approximation
 from rkfx.parallel.ownership import numbering
@@ -123,14 +130,14 @@ class BiotOperators:
     """The matrices of eqs. (3.32)-(3.35) and (3.60) for one discretization.
 
     Attributes:
-        Kuu: Solid stiffness, shape ``(2n, 2n)``.
-        Kup: Coupling int B^T alpha m N, shape ``(2n, n)``.
+        Kuu: Solid stiffness, shape ``(g n, g n)`` (g = 2, or 3 in 3-D).
+        Kup: Coupling int B^T alpha m N, shape ``(g n, n)``.
         Ks: Compressibility int N^T S N, shape ``(n, n)``.
         Kh: Permeability int grad N^T k grad N, shape ``(n, n)``.
         fpp_rows: Rows N - Pi N on cells (3.61) and subcells (3.62), or empty when unstabilized.
-        fpp_weights: Matching weights A_L and eps_p A_C [m^2].
+        fpp_weights: Matching weights A_L and eps_p A_C [m^2] (volumes V_L, eps_p V_C in 3-D).
         fpp_node: Node whose eps_f applies to each row.
-        h: Characteristic length sqrt(A_L) of each node [m].
+        h: Characteristic length sqrt(A_L) (3-D: V_L^(1/3)) of each node [m].
     """
 
     Kuu: sp.csr_matrix
@@ -153,13 +160,14 @@ class BiotOperators:
 
 
 def divergence_matrix(q: Quadrature) -> sp.csr_matrix:
-    """Rows div u^h(x_q) over interleaved displacement coefficients, shape ``(m, 2n)``."""
+    """Rows div u^h(x_q) over interleaved displacement coefficients, shape ``(m, g n)``."""
     g = q.gradients
+    dim = g.num_components
     row = np.repeat(np.arange(g.num_rows), np.diff(g.indptr))
-    col = 2 * g.indices.astype(np.int64)
-    return sp.csr_matrix((np.concatenate([g.data[:, 0], g.data[:, 1]]),
-                          (np.concatenate([row, row]), np.concatenate([col, col + 1]))),
-                         shape=(g.num_rows, 2 * g.num_cols))
+    col = dim * g.indices.astype(np.int64)
+    return sp.csr_matrix((np.concatenate([g.data[:, c] for c in range(dim)]),
+                          (np.concatenate([row] * dim), np.concatenate([col + c for c in range(dim)]))),
+                         shape=(g.num_rows, dim * g.num_cols))
 
 
 @dataclass(frozen=True)
@@ -171,8 +179,8 @@ class NodalFields:
     material's constant.
 
     Attributes:
-        D: Elasticity per particle, shape ``(n, 3, 3)`` [Pa].
-        k: Mobility per particle, isotropic ``(n,)`` or a tensor ``(n, 2, 2)`` [m^2/(Pa s)].
+        D: Elasticity per particle, shape ``(n, 3, 3)`` [Pa] (``(n, 6, 6)`` in 3-D).
+        k: Mobility per particle, isotropic ``(n,)`` or a tensor ``(n, g, g)`` [m^2/(Pa s)].
         alpha: Biot coefficient per particle, shape ``(n,)`` [-].
         S: Storage coefficient per particle, shape ``(n,)`` [1/Pa].
     """
@@ -182,9 +190,10 @@ class NodalFields:
     alpha: np.ndarray | None = None
     S: np.ndarray | None = None
 
-    def check(self, n: int) -> None:
-        """Raise if a field does not have one value per particle."""
-        for name, shapes in (("D", [(n, 3, 3)]), ("k", [(n,), (n, 2, 2)]), ("alpha", [(n,)]), ("S", [(n,)])):
+    def check(self, n: int, dim: int = 2) -> None:
+        """Raise if a field does not have one value per particle (in ``dim`` dimensions)."""
+        v = 3 if dim == 2 else 6
+        for name, shapes in (("D", [(n, v, v)]), ("k", [(n,), (n, dim, dim)]), ("alpha", [(n,)]), ("S", [(n,)])):
             v = getattr(self, name)
             if v is not None and np.shape(v) not in shapes:
                 raise InputError(f"nodal field {name} has shape {np.shape(v)}; give one value per particle: "
@@ -229,6 +238,15 @@ def biot_integration(p: Particles, rk: RKApproximation, domains: NodalDomains, v
         raise InputError(f"unknown variant {variant!r}; choose one of {', '.join(VARIANTS)}")
     d = domains
     mine = np.arange(p.num_nodes) if nodes is None else np.asarray(nodes, np.int64)
+    if p.x.shape[1] == 3:
+        _, sub = selected_cells(d, nodes)
+        owner = d.subcell_node[sub]
+        if variant.startswith("scni"):
+            nodal, rules, values = mscni_rules_3d(p, rk, d, eps_p, nodes=nodes)
+            return BiotIntegration(nodal, [nodal, values], [mine, owner], rules, [mine] * (len(rules) - 1) + [owner],
+                                   mine, sub)
+        nodal = dni_3d(p, rk, d, nodes=nodes)
+        return BiotIntegration(nodal, [nodal], [mine], [nodal], [mine], mine, sub)
     if variant.startswith("scni"):
         nodal, rules, values = mscni_rules(p, rk, d, eps_p, nodes=nodes)
         _, sub = selected_cells(d, nodes)
@@ -245,7 +263,8 @@ def projection_rows(rk: RKApproximation, domains: NodalDomains, integration: Bio
     """The rows N - Pi N of the fluid pressure projection on cells (3.61) and, with the MSCNI
     subcells, on subcells (3.62), with their weights and the node whose eps_f applies."""
     d, it = domains, integration
-    n, mine = len(d.area), it.nodes
+    area, subcell_area = cell_measures(d)  # volumes in 3-D
+    n, mine = len(area), it.nodes
     # (3.61): Pi N(x_L) = sum_C N(x_hat_C) A_C / A_L, so the cell rows are N(x_L) - Pi N(x_L).
     sub = np.arange(len(d.subcell_node)) if it.subcells is None else it.subcells
     owner = d.subcell_node[sub]
@@ -253,9 +272,9 @@ def projection_rows(rk: RKApproximation, domains: NodalDomains, integration: Bio
     order = np.argsort(owner, kind="stable")
     counts = np.bincount(owner, minlength=n)[mine]
     ptr = np.r_[0, np.cumsum(counts)]
-    cell_rows = combine_rows(at_centroids, ptr, order, -(d.subcell_area[sub] / d.area[owner])[order],
+    cell_rows = combine_rows(at_centroids, ptr, order, -(subcell_area[sub] / area[owner])[order],
                              base=it.nodal.values, base_row=np.arange(len(mine)))
-    rows, weights, row_nodes = [cell_rows], [d.area[mine]], [mine]
+    rows, weights, row_nodes = [cell_rows], [area[mine]], [mine]
     if len(it.quads) > 1:
         # (3.62): Pi N(x_hat_C) = N(x_hat_C): the subcell rows are the MSCNI value rows.
         stab = it.quads[1]
@@ -280,12 +299,12 @@ def biot_operators(p: Particles, rk: RKApproximation, domains: NodalDomains, mat
             rank's own nodes); the operators of a partition's parts sum to the whole ones.
     """
     d = domains
-    n = p.num_nodes
+    n, dim = p.num_nodes, p.x.shape[1]
     fields = NodalFields() if fields is None else fields
-    fields.check(n)
+    fields.check(n, dim)
     it = biot_integration(p, rk, d, variant, eps_p, nodes)
     quads, nodal, mine = it.quads, it.nodal, it.nodes
-    kuu = stiffness(it.gradient_quads, it.at_points(fields.D, material.elastic.D(), gradients=True))
+    kuu = stiffness(it.gradient_quads, it.at_points(fields.D, material.elastic.voigt(dim), gradients=True))
     # Coupling (3.57): nodal points only.
     alpha = material.alpha if fields.alpha is None else np.asarray(fields.alpha, float)[mine]
     kup = (divergence_matrix(nodal).T @ sp.diags(alpha * nodal.weights) @ nodal.values.matrix()).tocsr()
@@ -293,10 +312,11 @@ def biot_operators(p: Particles, rk: RKApproximation, domains: NodalDomains, mat
         else sp.csr_matrix((n, n))
     kh = laplacian(it.gradient_quads, it.at_points(fields.k, material.k, gradients=True))
     rows, weights, row_nodes = projection_rows(rk, d, it) if variant.endswith("+fpp") else ([], [], [])
-    h = np.sqrt(d.area)
+    # eq. (3.53): h = sqrt(A_I) in 2-D, the cube root of the cell volume in 3-D.
+    h = cell_measures(d)[0] ** (1.0 / dim)
     if nodes is not None:  # the other nodes' cells may be partial (domains built around ``nodes``)
         h = np.ones(n)
-        h[mine] = np.sqrt(d.area[mine])
+        h[mine] = cell_measures(d)[0][mine] ** (1.0 / dim)
     return BiotOperators(kuu, kup, ks, kh, rows, weights, row_nodes, h)
 
 
@@ -309,9 +329,9 @@ class BiotSolution:
     Attributes:
         rk: The approximation (shared by u and p).
         times: Output times, shape ``(k,)`` [s].
-        U: Displacement coefficients, shape ``(k, n, 2)`` [m].
+        U: Displacement coefficients, shape ``(k, n, g)`` [m] (g = 2, or 3 in 3-D).
         P: Pressure coefficients, shape ``(k, n)`` [Pa].
-        n_dofs: Unknowns per step (3 n).
+        n_dofs: Unknowns per step ((g + 1) n).
         wall_time_s: Assembly plus time stepping [s].
         steps: Number of time steps taken.
         timings: Wall times of the stages [s].
@@ -334,23 +354,26 @@ class BiotSolution:
         return (evaluate(self.rk, points).matrix() @ self.P.T).T
 
     def displacement(self, points: np.ndarray) -> np.ndarray:
-        """u^h at points for every output time, shape ``(k, m, 2)`` [m]."""
+        """u^h at points for every output time, shape ``(k, m, g)`` [m]."""
         n = evaluate(self.rk, points).matrix()
-        return np.stack([(n @ self.U[:, :, c].T).T for c in range(2)], axis=-1)
+        return np.stack([(n @ self.U[:, :, c].T).T for c in range(self.U.shape[2])], axis=-1)
 
     def strain(self, points: np.ndarray) -> np.ndarray:
         """Strain of u^h (direct gradients) at points for every output time, Voigt (xx, yy, 2 xy),
-        shape ``(k, m, 3)`` [-]."""
+        shape ``(k, m, 3)`` [-]; in 3-D (xx, yy, zz, 2 yz, 2 xz, 2 xy), shape ``(k, m, 6)``."""
         rows = evaluate(self.rk, points, gradients=True)
-        dx, dy = rows.matrix(1), rows.matrix(2)
-        ux, uy = self.U[:, :, 0].T, self.U[:, :, 1].T
-        return np.stack([(dx @ ux).T, (dy @ uy).T, (dy @ ux + dx @ uy).T], axis=-1)
+        g = self.U.shape[2]
+        du = [[(rows.matrix(1 + j) @ self.U[:, :, i].T).T for j in range(g)] for i in range(g)]  # du_i/dx_j
+        if g == 2:
+            return np.stack([du[0][0], du[1][1], du[0][1] + du[1][0]], axis=-1)
+        return np.stack([du[0][0], du[1][1], du[2][2], du[1][2] + du[2][1], du[0][2] + du[2][0],
+                         du[0][1] + du[1][0]], axis=-1)
 
 
 class BiotModel(Stateless):
     """The u-p equations (3.32)-(3.37) as a model for the steppers (``rkfx.solvers``).
 
-    Unknowns ``[u (2 n, interleaved), p (n)]``, both of time order 1 (u is quasi-static; its
+    Unknowns ``[u (g n, interleaved), p (n)]``, both of time order 1 (u is quasi-static; its
     rate enters the storage equation). With C = [[0, 0], [Kup^T, S(dt)]] and
     r = [Kuu u - Kup p - F^ext(t), Kh p - Q^ext(t)] the model reads C x' + r(x, t) = 0:
     Kup^T u' + S p' + Kh p = Q^ext. S(dt) is the compressibility plus the rate-form projection
@@ -365,8 +388,8 @@ class BiotModel(Stateless):
         operators: The matrices of one discretization.
         material: Poroelastic constants.
         collocation: Collocated essential conditions (of u and p, or of p alone with Nitsche).
-        nodes: Node coordinates at which the conditions are collocated, shape ``(n, 2)`` [m].
-        loads: F^ext(t), Q^ext(t) as ``(2 n,)`` and ``(n,)`` arrays.
+        nodes: Node coordinates at which the conditions are collocated, shape ``(n, g)`` [m].
+        loads: F^ext(t), Q^ext(t) as ``(g n,)`` and ``(n,)`` arrays.
         local: On MPI ranks, the rank's local unknowns (``rkfx.parallel.unknowns``): the
             operators, loads and collocation rows are then the rank's own contributions, and the
             model lives on the local nodes (``share`` tells the steppers); ``None``: the whole model.
@@ -380,7 +403,8 @@ class BiotModel(Stateless):
         self.nodes, self.local = nodes, local
         self.share = None if local is None else local.share
         n = operators.Kh.shape[0] if local is None else len(local.nodes)
-        self.layout = layout(("u", 2, 1), ("p", 1, 1), nodes=n)
+        self.dim = operators.Kuu.shape[0] // operators.Kh.shape[0]
+        self.layout = layout(("u", self.dim, 1), ("p", 1, 1), nodes=n)
         self.linear = True
         o = operators
         kuu, kup = o.Kuu, o.Kup
@@ -411,9 +435,9 @@ class BiotModel(Stateless):
         return None
 
     def capacity(self, dt: float) -> sp.csr_matrix:
-        n = self.operators.Kh.shape[0]
+        n, g = self.operators.Kh.shape[0], self.dim
         return self._per_step.get("capacity", dt, lambda dt: self._local(sp.bmat(
-            [[sp.csr_matrix((2 * n, 2 * n)), None], [self.operators.Kup.T, self.storage(dt)]], format="csr")))
+            [[sp.csr_matrix((g * n, g * n)), None], [self.operators.Kup.T, self.storage(dt)]], format="csr")))
 
     def constraints(self, t: float) -> Constraints:
         return Constraints(self._G, self.collocation.values(self.nodes, t))
@@ -422,30 +446,31 @@ class BiotModel(Stateless):
         """-1 / (du'/du) on the storage rows: the symmetric saddle-point Jacobian
         [[Kuu, -Kup], [-Kup^T, -S - theta dt Kh]] of eqs. (3.50)-(3.51)."""
         n = self._n
-        return np.r_[np.ones(2 * n), np.full(n, -1.0 / co.dv[0])]
+        return np.r_[np.ones(self.dim * n), np.full(n, -1.0 / co.dv[0])]
 
 
 class _Outputs:
     """Nodal coefficients kept at the output times (on MPI ranks, each rank those of its own
     nodes; ``whole`` sums them over the ranks)."""
 
-    def __init__(self, wanted: np.ndarray, n: int, local: LocalUnknowns | None = None):
+    def __init__(self, wanted: np.ndarray, n: int, local: LocalUnknowns | None = None, dim: int = 2):
         self.wanted, self.local = wanted, local
-        self.U = np.zeros((len(wanted), n, 2))
+        self.U = np.zeros((len(wanted), n, dim))
         self.P = np.zeros((len(wanted), n))
-        self.n = n
+        self.n, self.g = n, dim
 
     def record(self, s) -> None:
         j = np.flatnonzero(np.abs(self.wanted - s.t) <= 1e-12 * np.maximum(self.wanted, 1.0))
+        g = self.g
         for i in j:
             if self.local is None:
-                self.U[i] = s.x[:2 * self.n].reshape(self.n, 2)
-                self.P[i] = s.x[2 * self.n:]
+                self.U[i] = s.x[:g * self.n].reshape(self.n, g)
+                self.P[i] = s.x[g * self.n:]
             else:
                 loc, own = self.local, self.local.num_owned_nodes
                 m = len(loc.nodes)
-                self.U[i][loc.nodes[:own]] = s.x[:2 * m].reshape(m, 2)[:own]
-                self.P[i][loc.nodes[:own]] = s.x[2 * m:2 * m + own]
+                self.U[i][loc.nodes[:own]] = s.x[:g * m].reshape(m, g)[:own]
+                self.P[i][loc.nodes[:own]] = s.x[g * m:g * m + own]
 
     def whole(self) -> tuple[np.ndarray, np.ndarray]:
         """U and P of every node (a sum over the ranks of their own nodes' values)."""
@@ -464,7 +489,7 @@ class _Outputs:
 
 def boundary_loads(p: Particles, bq: BoundaryQuadrature, tractions: Sequence[Traction], fluxes: Sequence[Flux]
                    ) -> Callable[[float], tuple[np.ndarray, np.ndarray]]:
-    """t -> (int N^T t_bar dGamma (2 n,), -int N q_bar . n dGamma (n,)): the boundary terms of
+    """t -> (int N^T t_bar dGamma (g n,), -int N q_bar . n dGamma (n,)): the boundary terms of
     F^ext (3.36) and Q^ext (3.37) on the boundary quadrature ``bq``."""
     n = p.num_nodes
     nb = bq.rows.matrix(0)
@@ -472,7 +497,7 @@ def boundary_loads(p: Particles, bq: BoundaryQuadrature, tractions: Sequence[Tra
     flux_points = [part_points(p, bq, fl.boundary) for fl in fluxes]
 
     def loads(t):
-        f = np.zeros((n, 2))
+        f = np.zeros((n, bq.dim))
         for tr, sel in zip(tractions, traction_points):
             f += nb[sel].T @ (bq.weights[sel, None] * traction_values(tr, bq, sel, t))
         q = np.zeros(n)
@@ -498,7 +523,8 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
     Initial state u = 0, p = 0. Loads and prescribed values are evaluated at t_{n+1} (3.39)-(3.40).
 
     Args:
-        p: Particles with named boundary parts.
+        p: Particles with named boundary parts: 2-D ``Particles`` (plane strain) or 3-D
+            ``Particles3D``.
         material: Poroelastic constants.
         times: Step times, shape ``(N + 1,)`` [s], starting at 0 (see ``time_grid``).
         output_times: Times at which to keep the solution; each must be one of ``times``.
@@ -507,14 +533,16 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
             impermeable.
         variant: ``ni``, ``scni``, ``ni+fpp`` or ``scni+fpp``.
         support_factor: a_I = c h_I.
-        gravity: Gravitational acceleration g, e.g. ``(0, -9.81)`` [m/s^2]; ``None`` for none.
+        gravity: Gravitational acceleration g, e.g. ``(0, -9.81)`` (3-D: ``(0, 0, -9.81)``)
+            [m/s^2]; ``None`` for none.
         density: Mixture density rho = n_f rho_f + (1 - n_f) rho_s [kg/m^3] (body force rho g).
         fluid_density: rho_f [kg/m^3] (Darcy flux -k (grad p - rho_f g), eq. 3.10).
         comm, solver: Passed to the linear solver (PETSc when installed).
         progress: Optional wrapper of the step iterator (e.g. a progress bar).
         rk: The RK approximation of u and p (default: linear basis, support
             ``support_factor`` h_I, no cracks).
-        domains: Nodal domains of the integration (default: median-dual cells of ``p``).
+        domains: Nodal domains of the integration (default: ``rkfx.geometry.cells.nodal_cells``:
+            median-dual cells of ``p``, or the box cells of a 3-D tensor grid).
         fields: Per-particle material fields (stiffness, permeability tensor, Biot coefficient,
             storage) in place of the material's constants.
         checkpoint_every, checkpoint_dir: Write a checkpoint every so many steps.
@@ -546,6 +574,7 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
     if solver == "fieldsplit" and not nitsche:
         raise InputError("solver='fieldsplit' preconditions the displacement block by multigrid, which needs the "
                          "displacement conditions in it: use bc_method='nitsche'")
+    g = p.x.shape[1]
     if nitsche and fields is not None and (fields.D is not None or fields.alpha is not None):
         raise InputError("bc_method='nitsche' takes the material's constant D and alpha on the boundary; per-particle "
                          "fields D or alpha need bc_method='transformation'")
@@ -562,28 +591,31 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
         num = numbering(rcb(p.x, comm.size), comm.size)
         mine = num.old_of_new[num.ranges[comm.rank]:num.ranges[comm.rank + 1]]
     # On ranks, only the domains around the rank's own nodes (the cells it integrates over).
-    d = nodal_domains(p, nodes=mine) if domains is None else domains
+    d = nodal_cells(p, nodes=mine) if domains is None else domains
     if distributed:
         segments = np.flatnonzero(np.isin(d.boundary.node, mine))
     ops = biot_operators(p, rk, d, material, variant, fields=fields, nodes=mine)
     bq = boundary_quadrature(p, d, rk, segments=segments)
-    collocated = [(pressures, 2 * n, 1)] if nitsche else [(displacements, 0, 2), (pressures, 2 * n, 1)]
-    col = collocation(p, rk, collocated, 3 * n, nodes=mine)
-    weak = nitsche_rows(p, bq, material.elastic.D(), displacements, nitsche_penalty) if nitsche else []
+    collocated = [(pressures, g * n, 1)] if nitsche else [(displacements, 0, g), (pressures, g * n, 1)]
+    col = collocation(p, rk, collocated, (g + 1) * n, nodes=mine)
+    weak = nitsche_rows(p, bq, material.elastic.voigt(g), displacements, nitsche_penalty) if nitsche else []
     boundary_terms = None
     if nitsche:
-        boundary_terms = (sum((r.matrix() for r in weak), sp.csr_matrix((2 * n, 2 * n))).tocsr(),
+        boundary_terms = (sum((r.matrix() for r in weak), sp.csr_matrix((g * n, g * n))).tocsr(),
                           nitsche_pressure_coupling(bq, weak, material.alpha))
     nb = bq.rows.matrix(0)
     # Gravity (3.36)-(3.37), integrated at the nodes like the other nodal terms.
-    f_gravity, q_gravity = np.zeros(2 * n), np.zeros(n)
+    f_gravity, q_gravity = np.zeros(g * n), np.zeros(n)
     if gravity is not None:
-        g = np.asarray(gravity, float).reshape(2)
-        nodal = dni(p, rk, d, nodes=mine) if not variant.startswith("scni") else scni(p, rk, d, nodes=mine)
+        gv = np.asarray(gravity, float).reshape(g)
+        if g == 3:
+            nodal = dni_3d(p, rk, d, nodes=mine) if not variant.startswith("scni") else scni_3d(p, rk, d, nodes=mine)
+        else:
+            nodal = dni(p, rk, d, nodes=mine) if not variant.startswith("scni") else scni(p, rk, d, nodes=mine)
         w = nodal.weights
-        f_gravity = (nodal.values.matrix().T @ (w[:, None] * density * g)).ravel()
+        f_gravity = (nodal.values.matrix().T @ (w[:, None] * density * gv)).ravel()
         grad = nodal.gradients
-        q_gravity = material.k * fluid_density * (grad.matrix(0).T @ (w * g[0]) + grad.matrix(1).T @ (w * g[1]))
+        q_gravity = material.k * fluid_density * sum(grad.matrix(c).T @ (w * gv[c]) for c in range(g))
     timings["assemble"] = time.perf_counter() - t0
     t0 = time.perf_counter()
 
@@ -602,16 +634,17 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
         kuu, kup = (ops.Kuu, ops.Kup) if boundary_terms is None else (ops.Kuu + boundary_terms[0],
                                                                      ops.Kup + boundary_terms[1])
         whole = sp.bmat([[kuu, -kup], [ops.Kup.T, ops.Ks + ops.stabilization(np.ones(n))]], format="csr")
-        touched = touched_nodes((2, 1), n, whole, col.G)
-        local = local_unknowns(num, np.unique(np.r_[touched, nb.indices, mine]), (2, 1), comm)
+        touched = touched_nodes((g, 1), n, whole, col.G)
+        local = local_unknowns(num, np.unique(np.r_[touched, nb.indices, mine]), (g, 1), comm)
     model = BiotModel(ops, material, col, p.x, loads, local, nitsche=boundary_terms)
-    kept = _Outputs(wanted, n, local)
+    kept = _Outputs(wanted, n, local, g)
     split = None
     if solver == "fieldsplit":
         # Fixed stress: the coupling's share of the pressure Schur complement, alpha^2 / K_dr
-        # int N_I with K_dr = lambda + mu of plane strain and int N_I = A_I (partition of unity).
-        lam, mu = material.elastic.lame
-        split = DisplacementSplit(p.x, material.alpha**2 / (lam + mu) * d.area)
+        # int N_I with the drained bulk modulus K_dr = lambda + 2 mu / g (lambda + mu in plane
+        # strain) and int N_I = A_I (V_I in 3-D; partition of unity).
+        lam, mu = material.elastic.lame if g == 2 else (material.elastic.lame_lambda, material.elastic.shear_modulus)
+        split = DisplacementSplit(p.x, material.alpha**2 / (lam + 2.0 * mu / g) * cell_measures(d)[0])
     solves = Factorizations(comm, solver, split=split)
     try:
         integrate(backward_euler(), model, t_all, recorder=kept, comm=comm, solves=solves,
@@ -622,5 +655,5 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
     timings["steps"] = time.perf_counter() - t0
     count, iterations = solves.linear_iterations()
     U, P = kept.whole()
-    return BiotSolution(rk, wanted, U, P, 3 * n, sum(timings.values()), len(t_all) - 1, timings,
+    return BiotSolution(rk, wanted, U, P, (g + 1) * n, sum(timings.values()), len(t_all) - 1, timings,
                         {"solver": solver, "solves": count, "iterations": iterations})

@@ -2,7 +2,7 @@
 
 Why RCB: RK shape functions have compact supports of a few spacings, so the nodes a rank
 must know besides its own (its ghosts) are those within one support of its evaluation points.
-RCB cuts the node cloud by straight lines into compact, nearly square parts, so that ghost
+RCB cuts the node cloud by straight lines (planes in 3-D) into compact, nearly square parts, so that ghost
 layer stays a thin band along the cuts, of a width of one support. It costs a few sorts
 (O(n log n log P)), is deterministic, so every rank computes the same partition from the
 same coordinates with no communication, and needs no graph partitioner (no extra dependency).
@@ -18,11 +18,11 @@ def rcb(x: np.ndarray, num_parts: int, weights: np.ndarray | None = None) -> np.
     Each step splits a set of nodes meant for k parts into sets for floor(k/2) and
     ceil(k/2) parts, cutting across the longer side of their bounding box at the weighted
     quantile floor(k/2)/k (the weighted median when k is even), so any count of parts works.
-    Ties in the cut coordinate are broken by the other coordinate and then by node index,
-    so the result depends only on ``x`` and ``weights``.
+    Ties in the cut coordinate are broken by the other coordinates (x before y before z) and
+    then by node index, so the result depends only on ``x`` and ``weights``.
 
     Args:
-        x: Node coordinates, shape ``(num_nodes, 2)`` [m].
+        x: Node coordinates, shape ``(num_nodes, 2)`` or ``(num_nodes, 3)`` [m].
         num_parts: Number of parts, 1 <= num_parts <= num_nodes.
         weights: Non-negative work per node, shape ``(num_nodes,)`` (default: all 1).
 
@@ -31,8 +31,8 @@ def rcb(x: np.ndarray, num_parts: int, weights: np.ndarray | None = None) -> np.
         the cuts (lower coordinates first); every part has at least one node.
     """
     x = np.asarray(x, dtype=np.float64)
-    if x.ndim != 2 or x.shape[1] != 2:
-        raise InputError(f"rcb takes node coordinates of shape (num_nodes, 2), not {x.shape}")
+    if x.ndim != 2 or x.shape[1] not in (2, 3):
+        raise InputError(f"rcb takes node coordinates of shape (num_nodes, 2) or (num_nodes, 3), not {x.shape}")
     n = len(x)
     if int(num_parts) != num_parts or not 1 <= num_parts <= n:
         raise InputError(f"num_parts = {num_parts!r} must be an integer from 1 to the {n} nodes")
@@ -51,8 +51,9 @@ def rcb(x: np.ndarray, num_parts: int, weights: np.ndarray | None = None) -> np.
         k_lo = k // 2
         xs = x[idx]
         extent = xs.max(axis=0) - xs.min(axis=0)
-        axis = 0 if extent[0] >= extent[1] else 1
-        order = idx[np.lexsort((idx, xs[:, 1 - axis], xs[:, axis]))]
+        axis = int(np.argmax(extent))  # the first of equally long sides
+        others = [xs[:, a] for a in range(x.shape[1] - 1, -1, -1) if a != axis]
+        order = idx[np.lexsort((idx, *others, xs[:, axis]))]
         cum = np.cumsum(w[order])
         target = cum[-1] * k_lo / k
         j = int(np.searchsorted(cum, target))  # cum[j - 1] < target <= cum[j]
