@@ -5,17 +5,23 @@ data path (see docs/core.md):
 
     geometry        node sets and their nodal domains
         particles        nodes, spacing, background triangulation, named boundaries
-        gmsh_nodes       particles from gmsh models and .geo files (needs gmsh)
+        particles3d      3-D nodes with a tetrahedralization: tensor grids, jittered grids
+        gmsh_nodes       particles from gmsh models and .geo files, 2-D and 3-D (needs gmsh)
+        gmsh_solids      the 3-D benchmark solids as gmsh models: sphere octant, box, L-block
         nodal_domains    conforming median-dual cells, subcells, boundary segments
         grid_cells       rectangular Voronoi cells of tensor grids, with slits along cell faces
+        nodal_cells3d    3-D cells: median-dual cells of tetrahedra, box cells of grids (13 points)
+        cells            the default nodal cells of a particle set, in either dimension
     approximation   the RK approximation
         kernel           cubic B-spline kernel
-        neighbours       cell-list search of the supports covering a point
-        shape_functions  RK shape functions and direct gradients (eqs. 3.17-3.25)
+        neighbours       cell-list search of the supports covering a point (neighbours3d in 3-D)
+        shape_functions  RK shape functions and direct gradients (eqs. 3.17-3.25); 3-D kernels in
+                         shape_functions3d, reached through the same ``evaluate``
         diffraction      pre-existing cracks: diffraction of the kernel supports round crack tips
         sparse_rows      rows of shape-function values and gradients, and their combinations
     integration     integration rules as sparse rows
         quadrature       Gauss, DNI, SCNI and MSCNI rules (eqs. 3.55-3.56)
+        nodal_rules3d    DNI, SCNI and MSCNI on 3-D cells (facet-smoothed gradients, 13-point rule)
         norms            error norms
     assembly        operators and conditions
         operators        B^T D B w products: stiffness, diffusion, mass, loads
@@ -23,15 +29,16 @@ data path (see docs/core.md):
         smeared_strain   the smeared strain of explicit SCNI, lumped mass, stable step (eq. 4.31-4.35)
         local_strain     one rank's share of the smeared strain: strains at its particles, forces on its nodes
     materials       constitutive laws
-        elasticity       the 2-D elastic law (plane strain or stress), principal directions
+        elasticity       the elastic law: 2-D (plane strain or stress) and 3-D, principal directions
         damage_law       Mazars' strain and the softening law compiled, shared by statics and dynamics
         crack_flow       flow in damaged particles: aperture, cubic law, anisotropic permeability (ch. 5)
     fracture        the damage particle method (chapter 4)
         damage           damage points: regularization by the cell chord (4.28), trial updates
         tracking         candidate damage particles along crack segments (eq. 4.22)
     models          what the steppers advance
-        elastostatics    plane-strain elastostatics
-        poroelasticity   equal-order u-p Biot model: NI/SCNI with pressure projection (chapter 3)
+        elastostatics    elastostatics in 2-D and 3-D
+        poroelasticity   equal-order u-p Biot model: NI/SCNI with pressure projection (chapter 3),
+                         in 2-D and 3-D
         damage_bar       the damaging bar under displacement control (chapter 4)
         damage_dynamics  the damage particle method in explicit dynamics, runs kept on disk
         damage_ranks     the same over MPI ranks: each rank steps its own particles

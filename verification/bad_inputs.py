@@ -228,6 +228,10 @@ ROWS: list[Row] = [
                                 ("grid not whole across the column", "ny=20"),
                                 ("probe above the column", "probes=1.5"), ("zero largest step", "max_step=0")]),
     Row("too big for memory", "liakopoulos", ("--set", "ny=99999991")),
+    *_case_rows("cryer", [("mesh coarser than the sphere", "mesh_size=0.9"), ("unknown RKPM variant", "variants=gauss2"),
+                          ("negative radius", "radius=-1"), ("step growth below 1", "growth=0.5"),
+                          ("no output time", "t_D=-0.1")]),
+    Row("too big for memory", "cryer", ("--set", "mesh_size=0.01")),
     # --- geometry files ---
     Row("broken .geo file", "", code="from_geo('broken.geo')", setup=_file("broken.geo", BROKEN_GEO)),
     Row(".geo file with an undefined point", "", code="from_geo('undefined.geo')",

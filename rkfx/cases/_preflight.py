@@ -146,3 +146,14 @@ def support_factor_ok(support_factor: float, low: float = 1.0) -> None:
     if not (math.isfinite(support_factor) and support_factor > low):
         raise InputError(f"support_factor = {support_factor!r}: use a value > {low:g} (RK support radius / nodal "
                          "spacing; 1.5 is the usual choice)")
+
+
+def known(values, allowed, what: str) -> None:
+    """Raise InputError naming the first of ``values`` that is not one of ``allowed``.
+
+    Raises:
+        InputError: ``unknown <what> '<value>'; choose from <allowed>``.
+    """
+    for v in values:
+        if v not in allowed:
+            raise InputError(f"unknown {what} {v!r}; choose from {', '.join(allowed)}")

@@ -44,11 +44,22 @@ def summary_table(results, width: int = WIDTH) -> str:
     runs; columns that do not fit go to a continuation table, which repeats the method. A
     summary run (``info["study"] == "summary"``) gets a table of its own titled with what it
     aggregates (``info["of"]``, ``info["over"]``)."""
-    title = f"{results.case}: " + ", ".join(f"{k}={_fmt_value(v)}" for k, v in results.params.items())
+    tables = {k: v for k, v in results.params.items() if _is_records(v)}
+    title = f"{results.case}: " + ", ".join(f"{k}={_fmt_value(v)}" for k, v in results.params.items()
+                                            if k not in tables)
     out = [textwrap.fill(title, width, subsequent_indent="    ", break_on_hyphens=False)]
     for heading, runs in _studies(results.runs):
         out += ["", textwrap.fill(heading, width, subsequent_indent="    "), *_table(runs, width)]
+    for name, records in tables.items():  # e.g. a time-to-accuracy table
+        out += ["", f"{name}:", *_columns(list(dict.fromkeys(k for r in records for k in r)),
+                                          [[_cell(r.get(k)) for k in dict.fromkeys(k for r in records for k in r)]
+                                           for r in records], width)]
     return "\n".join(out)
+
+
+def _is_records(v) -> bool:
+    """A parameter that is a table: a non-empty list of dicts."""
+    return isinstance(v, list) and bool(v) and all(isinstance(r, dict) for r in v)
 
 
 def _studies(runs: Sequence) -> list[tuple[str, list]]:
@@ -81,6 +92,12 @@ def _table(runs: Sequence, width: int) -> list[str]:
     head = ["method", *info, "dofs", "wall [s]", *errs]
     rows = [[r.method, *(_cell(r.info.get(k)) for k in info), str(r.n_dofs), f"{r.wall_time_s:.2f}",
              *(_cell(r.errors.get(k)) for k in errs)] for r in runs]
+    return _columns(head, rows, width)
+
+
+def _columns(head: list[str], rows: list[list[str]], width: int) -> list[str]:
+    """Rows of cells under ``head``, columns that do not fit in ``width`` continued in further
+    tables that repeat the first column."""
     widths = [max(len(c) for c in col) for col in zip(head, *rows)]
     chunks, current, used = [], [0], widths[0]
     for i in range(1, len(head)):

@@ -107,12 +107,8 @@ def _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F, 
         raise InputError(f"growth = {growth!r} must be >= 1")
     if not t_D or min(t_D) <= 0:
         raise InputError(f"t_D = {t_D!r}: output times must be positive")
-    for v in list(variants) + list(early_variants):
-        if v not in VARIANTS:
-            raise InputError(f"unknown RKPM variant {v!r}; choose from {', '.join(VARIANTS)}")
-    for e in fem:
-        if e not in FEM_ELEMENTS:
-            raise InputError(f"unknown FEM element {e!r}; choose from {', '.join(FEM_ELEMENTS)}")
+    _preflight.known(list(variants) + list(early_variants), VARIANTS, "RKPM variant")
+    _preflight.known(fem, FEM_ELEMENTS, "FEM element")
     if F == 0:
         raise InputError("F = 0: the problem has no load")
     _preflight.support_factor_ok(support_factor)

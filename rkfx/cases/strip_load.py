@@ -122,12 +122,8 @@ def _check(nx, ny, dt_D, t_D_profile, t_D_end, extent, b, q, steps_low, variants
         raise InputError("q = 0: no load")
     if steps_low < 1:
         raise InputError(f"steps_low = {steps_low!r} must be >= 1")
-    for v in list(variants) + list(low_variants):
-        if v not in VARIANTS:
-            raise InputError(f"unknown RKPM variant {v!r}; choose from {', '.join(VARIANTS)}")
-    for e in fem:
-        if e not in FEM_ELEMENTS:
-            raise InputError(f"unknown FEM element {e!r}; choose from {', '.join(FEM_ELEMENTS)}")
+    _preflight.known(list(variants) + list(low_variants), VARIANTS, "RKPM variant")
+    _preflight.known(fem, FEM_ELEMENTS, "FEM element")
     if nx < STRIP_INTERVALS + 3 or ny < 4:
         raise InputError(f"nx = {nx}, ny = {ny}: need nx >= {STRIP_INTERVALS + 3} and ny >= 4")
     _preflight.support_factor_ok(support_factor)

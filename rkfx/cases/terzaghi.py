@@ -113,12 +113,8 @@ def _check(W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny, 
         raise InputError(f"t_out = {t_out!r}: output times must lie in (0, t_end]")
     if not growth >= 1:
         raise InputError(f"growth = {growth!r} must be >= 1")
-    for v in variants:
-        if v not in VARIANTS:
-            raise InputError(f"unknown RKPM variant {v!r}; choose from {', '.join(VARIANTS)}")
-    for e in fem:
-        if e not in FEM_ELEMENTS:
-            raise InputError(f"unknown FEM element {e!r}; choose from {', '.join(FEM_ELEMENTS)}")
+    _preflight.known(variants, VARIANTS, "RKPM variant")
+    _preflight.known(fem, FEM_ELEMENTS, "FEM element")
     _preflight.support_factor_ok(support_factor)
 
 
