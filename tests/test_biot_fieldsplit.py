@@ -67,3 +67,27 @@ def test_fieldsplit_refuses_what_it_cannot_precondition():
         linear_solver(a, solver="fieldsplit")
     with pytest.raises(InputError, match="split= is for solver='fieldsplit'"):
         linear_solver(a, solver="mumps", split=DisplacementSplit(np.zeros((2, 2))))
+
+
+def test_auto_takes_the_field_split_above_the_switch(monkeypatch):
+    """solver="auto": MUMPS below ``U_P_AUTO_DIRECT_MAX_DOFS`` unknowns, the field split above
+    with Nitsche's conditions in 2-D (the same pressures to GMRES's tolerance); collocated
+    conditions and 3-D stay direct."""
+    from rkfx.models import poroelasticity as up
+
+    assert up.choose_solver("auto", 10 * up.U_P_AUTO_DIRECT_MAX_DOFS, "nitsche", 2) == "fieldsplit"
+    assert up.choose_solver("auto", up.U_P_AUTO_DIRECT_MAX_DOFS, "nitsche", 2) == "mumps"
+    assert up.choose_solver("auto", 10 * up.U_P_AUTO_DIRECT_MAX_DOFS, "transformation", 2) == "mumps"
+    assert up.choose_solver("auto", 10 * up.U_P_AUTO_DIRECT_MAX_DOFS, "nitsche", 3) == "mumps"
+    with pytest.raises(InputError, match="unknown u-p solver 'gmres'"):
+        up.choose_solver("gmres", 10, "nitsche", 2)
+    material, exact, p, bcs = _mandel(0.0, 61, 7)
+    times = (LX / 60) ** 2 / exact.c * np.arange(4)
+    run = lambda solver: solve_biot(p, material, times, times[1:], bcs, [Pressure("right")],  # noqa: E731
+                                    bc_method="nitsche", solver=solver)
+    direct = run("auto")
+    monkeypatch.setattr(up, "U_P_AUTO_DIRECT_MAX_DOFS", 100)
+    split = run("auto")
+    assert direct.linear["solver"] == "mumps" and split.linear["solver"] == "fieldsplit"
+    assert split.linear["iterations"] > split.linear["solves"]
+    assert np.abs(split.P - direct.P).max() <= 1e-5 * np.abs(direct.P).max()

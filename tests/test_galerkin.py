@@ -164,3 +164,27 @@ def test_mscni_rules_give_the_mscni_forms(eps_p):
                  (mass(old), mass([nodal, values]))):
         assert abs(a - b).max() <= 1e-12 * abs(a).max()
     assert len(rules) == (1 if eps_p == 1.0 else 2)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_mixed_form_is_the_coupling_product(dim):
+    """``mixed_form``: gradient rows against value rows of the same points equal the product
+    div^T diag(w) N (the u-p coupling of eq. 3.57), in 2-D and 3-D."""
+    from rkfx.assembly.galerkin import mixed_form
+    from rkfx.approximation.shape_functions import evaluate
+    from rkfx.approximation.sparse_rows import SparseRows
+
+    rng = np.random.default_rng(5)
+    x = rng.uniform(0.0, 1.0, (300, dim))
+    rk = rk_approximation(x, np.full(len(x), 0.15 if dim == 2 else 0.3), 1.5)
+    pts = rng.uniform(0.2, 0.8, (200, dim))
+    grads = evaluate(rk, pts, gradients=True)
+    values = evaluate(rk, pts)
+    test = SparseRows(grads.indptr, grads.indices, grads.data[:, 1:], grads.num_cols)
+    w = rng.uniform(0.5, 2.0, len(pts))
+    got = mixed_form(test, values, w)
+    div = sp.hstack([test.matrix(c) for c in range(dim)]).tocsr()  # (m, g n) in component blocks
+    order = np.arange(dim * len(x)).reshape(dim, -1).T.ravel()  # to interleaved unknowns
+    expected = (div[:, order].T @ sp.diags(w) @ values.matrix()).tocsr()
+    assert got.shape == (dim * len(x), len(x)) and got.has_sorted_indices
+    assert abs(got - expected).max() <= 1e-14 * abs(expected).max()

@@ -198,6 +198,41 @@ def _scalar_fill(ptr_a, idx_a, val_a, ptr_b, idx_b, val_b, point_of, t_ptr, t_en
                     out_data[first + slot[idx[e]]] += acc
 
 
+@numba.njit(parallel=True, cache=True)
+def _mixed_fill(t_ptr, t_entry, point_of, test_val, tr_ptr, tr_idx, tr_val, weight, num_nodes, nchunks, node_ptr,
+                out_idx, out_data):
+    """The rows (I, a) of sum_q w_q a_I(q)_a b_J(q): the g components of the test rows a against
+    the scalar trial rows b of the same points (interleaved rows, g = test_val.shape[1])."""
+    g = test_val.shape[1]
+    empty_ptr = np.zeros(1, np.int64)
+    empty_idx = np.empty(0, tr_idx.dtype)
+    empty_val = np.empty((0, tr_val.shape[1]))
+    chunk = (num_nodes + nchunks - 1) // nchunks
+    for c in numba.prange(nchunks):
+        stamp = np.full(num_nodes, -1, np.int64)
+        slot = np.empty(num_nodes, np.int64)
+        t = np.empty(g)
+        for i in range(c * chunk, min(num_nodes, (c + 1) * chunk)):
+            width = node_ptr[i + 1] - node_ptr[i]
+            first = g * node_ptr[i]
+            cols = _columns(i, width, tr_ptr, tr_idx, tr_val, empty_ptr, empty_idx, empty_val, point_of, t_ptr,
+                            t_entry, stamp, slot)
+            for a in range(g):
+                for s in range(width):
+                    out_idx[first + a * width + s] = cols[s]
+                    out_data[first + a * width + s] = 0.0
+            for e_i in range(t_ptr[i], t_ptr[i + 1]):
+                p = t_entry[e_i]
+                q = point_of[p]
+                for a in range(g):
+                    t[a] = weight[q] * test_val[p, a]
+                for e in range(tr_ptr[q], tr_ptr[q + 1]):
+                    base = first + slot[tr_idx[e]]
+                    v = tr_val[e, 0]
+                    for a in range(g):
+                        out_data[base + a * width] += t[a] * v
+
+
 @dataclass(frozen=True)
 class _Points:
     """The rows of the points in at most two sets (A, then B), their transposed entries and
@@ -303,6 +338,42 @@ def scalar_form(rows: SparseRows | Sequence[SparseRows], weights: np.ndarray, me
     a = sp.csr_matrix((out_data, out_idx, node_ptr), shape=(n, n))
     a.has_sorted_indices = True
     return a
+
+
+def mixed_form(test: SparseRows, trial: SparseRows, weights: np.ndarray) -> sp.csr_matrix:
+    """B = sum_q w_q a_I(q)^T b_J(q) for test rows a with g components and scalar trial rows b of
+    the same points: rows (I, component) interleaved, columns J, shape ``(g n, n)``, sorted
+    indices. The u-p coupling int B^T alpha m N of eq. (3.57) is the gradient rows against the
+    value rows of the nodal points, weights alpha V_L.
+
+    Args:
+        test: Rows a_I(x_q), g components, shape ``(m, n)``.
+        trial: Rows b_J(x_q), one component, shape ``(m, n)``.
+        weights: w_q, shape ``(m,)``.
+    """
+    if test.num_rows != trial.num_rows or test.num_cols != trial.num_cols or trial.num_components != 1:
+        raise ValueError(f"test rows {test.num_rows} x {test.num_cols} and scalar trial rows {trial.num_rows} x "
+                         f"{trial.num_cols} ({trial.num_components} components) of different points")
+    pts = _points(test)
+    n, g = pts.num_nodes, test.num_components
+    tr_ptr, tr_idx, tr_val = trial.indptr, np.ascontiguousarray(trial.indices), _values(trial)
+    empty = SparseRows(np.zeros(1, np.int64), tr_idx[:0], tr_val[:0], n)
+    node_ptr = np.zeros(n + 1, np.int64)
+    _count(tr_ptr, tr_idx, tr_val, empty.indptr, empty.indices, empty.data, pts.point_of, pts.t_ptr, pts.t_entry, n,
+           work_items(n), node_ptr)
+    np.cumsum(node_ptr, out=node_ptr)
+    out_idx = np.empty(g * node_ptr[-1], np.int32)
+    out_data = np.empty(g * node_ptr[-1])
+    _mixed_fill(pts.t_ptr, pts.t_entry, pts.point_of, _values(test), tr_ptr, tr_idx, tr_val,
+                np.ascontiguousarray(weights, dtype=np.float64), n, work_items(n), node_ptr, out_idx, out_data)
+    indptr = np.empty(g * n + 1, np.int64)
+    for a in range(g):
+        indptr[a:-1:g] = g * node_ptr[:-1] + a * np.diff(node_ptr)
+    indptr[-1] = g * node_ptr[-1]
+    m = sp.csr_matrix((out_data, out_idx, indptr), shape=(g * n, n))
+    m.has_sorted_indices = True
+    m.eliminate_zeros()  # as a product of scipy matrices leaves them out (the same system for the solvers)
+    return m
 
 
 def _values(rows: SparseRows) -> np.ndarray:

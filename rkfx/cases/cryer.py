@@ -39,7 +39,8 @@ Studies, written to results.json and plotted:
 Parameters and units (``--set NAME=VALUE``): E [Pa], nu [-], k [m^2/(Pa s)], alpha [-], S [1/Pa],
 radius [m], load [Pa], mesh_size [m], dt_D [-], growth [-], hold [steps], max_dt_D [-],
 t_D (list) [-], variants (list), early_variants (list), early_dt_D [-], early_steps, fem (list),
-rkpm_levels (list) [m], fem_levels (list) [m], support_factor [-].
+rkpm_levels (list) [m], fem_levels (list) [m], support_factor [-], bc_method (transformation |
+nitsche), solver (auto | mumps | fieldsplit, which needs bc_method=nitsche; in 3-D auto is MUMPS).
 
     python -m rkfx.cases.cryer [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
         [--checkpoint-every N] [--resume DIR]
@@ -56,7 +57,7 @@ import numpy as np
 
 from verification.cryer import Cryer
 
-from rkfx.cases import _cli, _preflight
+from rkfx.cases import _cli, _preflight, _up_solver
 from rkfx.cases._cli import Param, Results, Run
 from rkfx.conditions import Displacement, Pressure, Traction
 from rkfx.errors import InputError
@@ -95,6 +96,7 @@ PARAMS = {
     "rkpm_levels": Param([0.1, 0.07, 0.05], "mesh sizes of the RKPM refinement (scni+fpp) [m]", fingerprint=False),
     "fem_levels": Param([0.2, 0.14, 0.1, 0.07], "mesh sizes of the Taylor-Hood refinement [m]", fingerprint=False),
     "support_factor": Param(1.5, "RK support radius / nodal spacing [-], > 1"),
+    **_up_solver.PARAMS,
 }
 QUICK = {"mesh_size": 0.1, "t_D": [0.01, 0.05, 0.1, 0.3], "early_variants": ["ni", "scni+fpp"],
          "rkpm_levels": [0.15, 0.1], "fem_levels": [0.2, 0.14]}
@@ -114,7 +116,8 @@ def _nodes(radius: float, size: float) -> float:
 
 
 def _check(*, E, nu, k, alpha, S, radius, load, mesh_size, dt_D, growth, hold, max_dt_D, t_D, variants,
-           early_variants, early_dt_D, early_steps, fem, rkpm_levels, fem_levels, support_factor):
+           early_variants, early_dt_D, early_steps, fem, rkpm_levels, fem_levels, support_factor,
+           bc_method="transformation", solver="auto"):
     Cryer(E, nu, k, radius, load, alpha, S)  # the material and geometry, named in one line
     PoroMaterial(E, nu, k, alpha, S)
     for name, sizes in (("mesh_size", [mesh_size]), ("rkpm_levels", rkpm_levels), ("fem_levels", fem_levels)):
@@ -133,6 +136,7 @@ def _check(*, E, nu, k, alpha, S, radius, load, mesh_size, dt_D, growth, hold, m
     _preflight.known(list(variants) + list(early_variants), VARIANTS, "RKPM variant")
     _preflight.known(fem, FEM_ELEMENTS, "FEM element")
     _preflight.support_factor_ok(support_factor)
+    _up_solver.check(bc_method, solver)
 
 
 def check(**params) -> None:
@@ -175,15 +179,16 @@ def _geometry(radius: float, size: float, fem: bool):
     return particles, mesh
 
 
-def _rkpm(p, material, bcs, times, variant, support_factor, samples, key, ck):
-    """One RKPM run: pressures at ``samples`` at every step, wall time, unknowns."""
+def _rkpm(p, material, bcs, times, variant, support_factor, samples, key, ck, up):
+    """One RKPM run: pressures at ``samples`` at every step, wall time, unknowns; ``up``: the solver
+    options (``bc_method``, ``solver``)."""
     kind = {Displacement: [], Pressure: [], Traction: []}
     for c in bcs:
         kind[type(c)].append(c)
     with _cli.model_run(key):
         sol = solve_biot(p, material, times, times[1:], kind[Displacement], kind[Pressure], kind[Traction],
                          variant=variant, support_factor=support_factor, comm=_cli.comm(),
-                         progress=lambda it: _cli.progress(it, key, len(times) - 1), **ck.for_run(key))
+                         progress=lambda it: _cli.progress(it, key, len(times) - 1), **ck.for_run(key), **up)
     return sol.pressure(samples), sol.wall_time_s, sol.n_dofs
 
 
@@ -212,12 +217,13 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, 
         load=1.0, mesh_size=0.05, dt_D=1.0e-3, growth=2.0, hold=20, max_dt_D=5.0e-3, t_D=(0.01, 0.05, 0.1, 0.3, 0.6),
         variants=("scni+fpp", "ni"), early_variants=VARIANTS, early_dt_D=1.0e-3, early_steps=10,
         fem=FEM_ELEMENTS, rkpm_levels=(0.1, 0.07, 0.05), fem_levels=(0.2, 0.14, 0.1, 0.07), support_factor=1.5,
-        checkpoint_every=0, work_dir=None, resume=None) -> Results:
+        bc_method="transformation", solver="auto", checkpoint_every=0, work_dir=None, resume=None) -> Results:
     """The three studies for every requested method; see the module docstring."""
     _check(E=E, nu=nu, k=k, alpha=alpha, S=S, radius=radius, load=load, mesh_size=mesh_size, dt_D=dt_D,
            growth=growth, hold=hold, max_dt_D=max_dt_D, t_D=t_D, variants=variants, early_variants=early_variants,
            early_dt_D=early_dt_D, early_steps=early_steps, fem=fem, rkpm_levels=rkpm_levels, fem_levels=fem_levels,
-           support_factor=support_factor)
+           support_factor=support_factor, bc_method=bc_method, solver=solver)
+    up = {"bc_method": bc_method, "solver": solver}
     material = PoroMaterial(E, nu, k, alpha, S)
     exact = Cryer(E, nu, k, radius, load, alpha, S)
     scale, p0 = exact.time_scale, exact.p0
@@ -234,6 +240,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, 
                   growth=growth, hold=hold, max_dt_D=max_dt_D, t_D=list(t_D), variants=list(variants),
                   early_variants=list(early_variants), early_dt_D=early_dt_D, early_steps=early_steps, fem=list(fem),
                   rkpm_levels=list(rkpm_levels), fem_levels=list(fem_levels), support_factor=support_factor,
+                  bc_method=bc_method, solver=solver,
                   c=exact.c, p0=p0, B=exact.B, time_scale=scale, steps=len(times) - 1,
                   peak_exact=exact.peak().ratio, peak_T_exact=exact.peak().T)
     results = Results(NAME, params)
@@ -245,7 +252,8 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, 
     if "rkpm" in methods:
         for v in dict.fromkeys(list(variants) + list(early_variants)):
             solvers.append((f"rkpm-{v}", v in variants, v in early_variants,
-                            lambda tt, key, v=v: _rkpm(p, material, bcs, tt, v, support_factor, samples, key, ck)))
+                            lambda tt, key, v=v: _rkpm(p, material, bcs, tt, v, support_factor, samples, key, ck,
+                                                       up)))
     if want_fem:
         for e in fem:
             solvers.append((f"fem-{e}", True, True,
@@ -276,12 +284,12 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, 
                 run_.wall_time_s, run_.n_dofs = wall, dofs
         results.runs.append(run_)
     _refinement(results, methods, material, exact, bcs, times, samples, rkpm_levels, fem_levels, fem, radius,
-                support_factor, ck, done)
+                support_factor, ck, done, up)
     return results
 
 
 def _refinement(results, methods, material, exact, bcs, times, samples, rkpm_levels, fem_levels, fem, radius,
-                support_factor, ck, done) -> None:
+                support_factor, ck, done, up) -> None:
     """The refinement study: one history run per level and method (the history study's run where
     the level is its mesh size), and the time to accuracy."""
     T = times[1:] / exact.time_scale
@@ -299,7 +307,7 @@ def _refinement(results, methods, material, exact, bcs, times, samples, rkpm_lev
         elif is_fem:
             ph, wall, dofs = _fem(mesh, material, bcs, times, fem[0], samples, key, ck)
         else:
-            ph, wall, dofs = _rkpm(p, material, bcs, times, "scni+fpp", support_factor, samples, key, ck)
+            ph, wall, dofs = _rkpm(p, material, bcs, times, "scni+fpp", support_factor, samples, key, ck, up)
         run_ = Run(f"{label} h={h:g}", wall, dofs,
                    info={"study": "refinement", "nodes": p.num_nodes, "mesh_size": h, "refinement": True})
         _history_errors(run_, exact, T, ph[:, 0], [])

@@ -34,7 +34,7 @@ unstabilized and with the pressure projection) from ``fem_baselines.poroelastici
 Parameters and units (``--set NAME=VALUE``): E [Pa], nu [-], k [m^2/(Pa s)], alpha [-],
 S [1/Pa], Lx [m], Ly [m], F [N/m], nx, ny, dt_D [-], growth [-], t_D (list), variants (list),
 early_variants (list), fem (list), support_factor [-], bc_method (transformation | nitsche),
-solver (mumps | fieldsplit: GMRES with a Schur split, for large grids, with bc_method=nitsche).
+solver (auto | mumps | fieldsplit: GMRES with a Schur split, for large grids, with bc_method=nitsche).
 
     python -m rkfx.cases.mandel [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
         [--checkpoint-every N] [--resume DIR] [--vtk]
@@ -57,10 +57,9 @@ from verification.mandel import Mandel
 from rkfx.conditions import Displacement, Pressure, split
 from rkfx.errors import InputError
 from rkfx.geometry.particles import structured
-from rkfx.assembly.boundary import BC_METHODS
 from rkfx.models.poroelasticity import VARIANTS, PoroMaterial, solve_biot
 from rkfx.solvers.integrate import time_grid
-from rkfx.cases import _cli, _paraview, _preflight
+from rkfx.cases import _cli, _paraview, _preflight, _up_solver
 from rkfx.cases._cli import Param, Results, Run
 from rkfx.report.claims import Claim
 
@@ -88,15 +87,14 @@ PARAMS = {
     "early_variants": Param(list(VARIANTS), "RKPM variants of the early-time study", fingerprint=False),
     "fem": Param(list(FEM_ELEMENTS), "FEM elements: taylor-hood, q1q1, q1q1-fpp", fingerprint=False),
     "support_factor": Param(1.5, "RK support radius / nodal spacing [-], > 1"),
-    "bc_method": Param("transformation", "RKPM displacement conditions: transformation (collocated) or nitsche"),
-    "solver": Param("mumps", "RKPM linear solver: mumps, or fieldsplit (GMRES with a Schur split; needs nitsche)"),
+    **_up_solver.PARAMS,
 }
 QUICK = {"nx": 41, "ny": 5, "t_D": [0.01, 0.1], "early_variants": ["ni", "scni+fpp"],
          "fem": ["taylor-hood", "q1q1-fpp"]}
 
 
 def _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F, support_factor=1.5,
-           bc_method="transformation", solver="mumps"):
+           bc_method="transformation", solver="auto"):
     for name, v in (("nx", nx), ("ny", ny)):
         if v < 3:
             raise InputError(f"{name} = {v}: need at least 3 nodes per direction")
@@ -112,16 +110,11 @@ def _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F, 
     if F == 0:
         raise InputError("F = 0: the problem has no load")
     _preflight.support_factor_ok(support_factor)
-    if bc_method not in BC_METHODS:
-        raise InputError(f"unknown bc_method {bc_method!r}; choose one of {', '.join(BC_METHODS)}")
-    if solver not in ("mumps", "fieldsplit"):
-        raise InputError(f"unknown solver {solver!r}; choose mumps or fieldsplit")
-    if solver == "fieldsplit" and bc_method != "nitsche":
-        raise InputError("solver=fieldsplit needs bc_method=nitsche (multigrid on the displacements)")
+    _up_solver.check(bc_method, solver)
 
 
 def check(*, E, nu, k, alpha, S, Lx, Ly, F, nx, ny, dt_D, growth, t_D, variants, early_variants, fem,
-          support_factor, bc_method="transformation", solver="mumps", **_) -> None:
+          support_factor, bc_method="transformation", solver="auto", **_) -> None:
     """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
     _check(nx, ny, dt_D, growth, t_D, variants, early_variants, fem, Lx, Ly, F, support_factor, bc_method, solver)
     PoroMaterial(E, nu, k, alpha, S)
@@ -148,7 +141,7 @@ def _conditions(exact):
 
 
 def _rkpm(p, material, bcs, times, outputs, variant, support_factor, desc, io, vtk=None, vtk_times=None,
-          bc_method="transformation", solver="mumps"):
+          bc_method="transformation", solver="auto"):
     """One RKPM run; with ``vtk`` a folder, its fields at ``vtk_times`` [s] are written there."""
     kinds = split(bcs)
     sol = solve_biot(p, material, times, outputs, kinds[Displacement], kinds[Pressure], variant=variant,
@@ -177,7 +170,7 @@ def _fem(xs, ys, material, bcs, times, outputs, element, samples, io, vtk=None, 
 def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, alpha=1.0, S=0.0, Lx=20.0,
         Ly=2.0, F=40.0, nx=101, ny=11, dt_D=0.01, growth=1.6, t_D=(0.01, 0.1, 0.5, 1.0),
         variants=("scni+fpp", "ni"), early_variants=VARIANTS, fem=FEM_ELEMENTS, support_factor=1.5,
-        bc_method="transformation", solver="mumps", checkpoint_every=0, work_dir=None, resume=None,
+        bc_method="transformation", solver="auto", checkpoint_every=0, work_dir=None, resume=None,
         vtk=None) -> Results:
     """Both studies for every requested method; see the module docstring. ``vtk``: a folder for the
     ParaView files of the profiles study's runs at the times ``t_D`` (``--vtk``)."""

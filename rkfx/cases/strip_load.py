@@ -29,7 +29,8 @@ Studies:
 Parameters and units (``--set NAME=VALUE``): E [Pa], nu [-], k [m^2/(Pa s)], k_low
 [m^2/(Pa s)], q [Pa], b [m], extent [-] (Lx = Ly = extent b), nx, ny, dt_D [-],
 t_D_profile [-], t_D_end [-], depth_history [m], steps_low, variants (list), low_variants
-(list), fem (list), support_factor [-].
+(list), fem (list), support_factor [-], bc_method (transformation | nitsche), solver (auto | mumps
+| fieldsplit, which needs bc_method=nitsche).
 
     python -m rkfx.cases.strip_load [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
         [--checkpoint-every N] [--resume DIR] [--vtk]
@@ -56,7 +57,7 @@ from rkfx.errors import InputError
 from rkfx.geometry.particles import graded
 from rkfx.models.poroelasticity import VARIANTS, PoroMaterial, solve_biot
 from rkfx.solvers.integrate import time_grid
-from rkfx.cases import _cli, _paraview, _preflight
+from rkfx.cases import _cli, _paraview, _preflight, _up_solver
 from rkfx.cases._cli import Param, Results, Run
 from rkfx.report.claims import Claim
 
@@ -83,6 +84,7 @@ PARAMS = {
     "low_variants": Param(["ni", "scni+fpp"], "RKPM variants of the low-permeability study", fingerprint=False),
     "fem": Param(["taylor-hood", "q1q1-fpp"], "FEM elements: taylor-hood, q1q1, q1q1-fpp", fingerprint=False),
     "support_factor": Param(1.5, "RK support radius / nodal spacing [-], > 1"),
+    **_up_solver.PARAMS,
 }
 QUICK = {"nx": 21, "ny": 21, "t_D_end": 0.5, "fem": ["taylor-hood"]}
 
@@ -110,7 +112,7 @@ def node_lines(b: float, length: float, n: int, first: float, uniform_to: float 
 
 
 def _check(nx, ny, dt_D, t_D_profile, t_D_end, extent, b, q, steps_low, variants, low_variants, fem,
-           support_factor=1.5, depth_history=0.0):
+           support_factor=1.5, depth_history=0.0, bc_method="transformation", solver="auto"):
     for name, v in (("b", b), ("extent", extent), ("dt_D", dt_D), ("t_D_profile", t_D_profile)):
         if not v > 0:
             raise InputError(f"{name} = {v!r} must be positive")
@@ -127,6 +129,7 @@ def _check(nx, ny, dt_D, t_D_profile, t_D_end, extent, b, q, steps_low, variants
     if nx < STRIP_INTERVALS + 3 or ny < 4:
         raise InputError(f"nx = {nx}, ny = {ny}: need nx >= {STRIP_INTERVALS + 3} and ny >= 4")
     _preflight.support_factor_ok(support_factor)
+    _up_solver.check(bc_method, solver)
     first = b / STRIP_INTERVALS
     _node_line_sizes(b, extent * b, nx, first, uniform_to=b, name="nx")
     _node_line_sizes(b, extent * b, ny, first, name="ny")
@@ -136,10 +139,10 @@ def _check(nx, ny, dt_D, t_D_profile, t_D_end, extent, b, q, steps_low, variants
 
 
 def check(*, E, nu, k, k_low, q, b, extent, nx, ny, dt_D, t_D_profile, t_D_end, depth_history, steps_low,
-          variants, low_variants, fem, support_factor, **_) -> None:
+          variants, low_variants, fem, support_factor, bc_method="transformation", solver="auto", **_) -> None:
     """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
     _check(nx, ny, dt_D, t_D_profile, t_D_end, extent, b, q, steps_low, variants, low_variants, fem,
-           support_factor, depth_history)
+           support_factor, depth_history, bc_method, solver)
     PoroMaterial(E, nu, k)
     try:
         PoroMaterial(E, nu, k_low)
@@ -153,9 +156,10 @@ def memory_need(methods, *, nx, ny, **_) -> _preflight.Need:
 
 
 def _solve(method, xs, ys, material, q, b, times, outputs, samples, drained, support_factor, io, vtk=None,
-           vtk_name="", vtk_times=None):
+           vtk_name="", vtk_times=None, up=None):
     """Pressure (k, m) and displacement (k, m, 2) at the samples, wall time, unknowns; with ``vtk``
-    a folder, the fields at ``vtk_times`` [s] are written there as ``vtk_name``."""
+    a folder, the fields at ``vtk_times`` [s] are written there as ``vtk_name``; ``up``: the RKPM
+    solver options (``bc_method``, ``solver``)."""
     # Fixed bottom, rollers on the sides, the surface drained or not: for RKPM and FEM alike.
     held = [Displacement("bottom"), Displacement("left", components=(0,)), Displacement("right", components=(0,))]
     held += [Pressure("top")] if drained else []
@@ -165,7 +169,8 @@ def _solve(method, xs, ys, material, q, b, times, outputs, samples, drained, sup
         kinds = split(held)
         sol = solve_biot(p, material, times, outputs, displacements=kinds[Displacement], pressures=kinds[Pressure],
                          tractions=[load], variant=method[5:], support_factor=support_factor,
-                         comm=_cli.comm(), progress=lambda it: _cli.progress(it, method, len(times) - 1), **io)
+                         comm=_cli.comm(), progress=lambda it: _cli.progress(it, method, len(times) - 1), **io,
+                         **(up or {}))
         if vtk is not None:
             _paraview.write_biot(vtk, vtk_name, p, sol, material.elastic, _cli.comm(), vtk_times)
         return sol.pressure(samples), sol.displacement(samples), sol.wall_time_s, sol.n_dofs
@@ -191,12 +196,14 @@ def _solve(method, xs, ys, material, q, b, times, outputs, samples, drained, sup
 def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.0, k=5.0e-8 / 9.8e3, k_low=5.0e-13 / 9.8e3,
         q=1.0e4, b=0.2, extent=25.0, nx=31, ny=31, dt_D=0.025, t_D_profile=0.1, t_D_end=2.0, depth_history=0.2,
         steps_low=4, variants=("scni+fpp", "ni"), low_variants=("ni", "scni+fpp"), fem=("taylor-hood", "q1q1-fpp"),
-        support_factor=1.5, checkpoint_every=0, work_dir=None, resume=None, vtk=None) -> Results:
+        support_factor=1.5, bc_method="transformation", solver="auto", checkpoint_every=0, work_dir=None, resume=None,
+        vtk=None) -> Results:
     """Both studies for every requested method; see the module docstring. ``vtk``: a folder for the
     ParaView files (``--vtk``)."""
     ck = _cli.Checkpoints(checkpoint_every, work_dir, resume)
     _check(nx, ny, dt_D, t_D_profile, t_D_end, extent, b, q, steps_low, variants, low_variants, fem,
-           support_factor, depth_history)
+           support_factor, depth_history, bc_method, solver)
+    up = {"bc_method": bc_method, "solver": solver}
     length = extent * b
     first = b / STRIP_INTERVALS
     xs = node_lines(b, length, nx, first, uniform_to=b)
@@ -217,7 +224,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.0, k=5.0e-8 /
     params = dict(E=E, nu=nu, k=k, k_low=k_low, q=q, b=b, extent=extent, nx=nx, ny=ny, dt_D=dt_D,
                   t_D_profile=t_D_profile, t_D_end=t_D_end, depth_history=depth_history, steps_low=steps_low,
                   variants=list(variants), low_variants=list(low_variants), fem=list(fem),
-                  support_factor=support_factor, dt=dt, steps=len(times) - 1)
+                  support_factor=support_factor, bc_method=bc_method, solver=solver, dt=dt, steps=len(times) - 1)
     results = Results(NAME, params)
     material = PoroMaterial(E, nu, k)
     drained = ([f"rkpm-{v}" for v in variants] if "rkpm" in methods else []) + \
@@ -226,7 +233,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.0, k=5.0e-8 /
     for label in drained:
         with _cli.model_run(label):
             p_h, _, wall, dofs = _solve(label, xs, ys, material, q, b, times, t_hist, samples, True, support_factor,
-                                        ck.for_run(label), vtk, label, [t_prof, t_end])
+                                        ck.for_run(label), vtk, label, [t_prof, t_end], up)
         prof, histp = p_h[i_prof, :-1], p_h[:, -1]
         results.runs.append(Run(
             label, wall, dofs,
@@ -245,7 +252,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.0, k=5.0e-8 /
         with _cli.model_run(f"{label} (low k)"):
             p_h, u_h, wall, dofs = _solve(label, xs, ys, low, q, b, t_low, t_low[-1:], field_pts, False,
                                           support_factor, ck.for_run(f"{label}-low-permeability"), vtk,
-                                          f"{label}-low-k", t_low[-1:])
+                                          f"{label}-low-k", t_low[-1:], up)
         pf = p_h[0].reshape(gx.shape)
         # Checkerboard measure: mean |second difference| of p between neighbouring nodes, over q.
         jump = (np.abs(np.diff(pf, 2, axis=0)).mean() + np.abs(np.diff(pf, 2, axis=1)).mean()) / (2 * q)

@@ -30,7 +30,8 @@ Studies:
 
 Parameters and units (``--set NAME=VALUE``): E [Pa], nu [-], k [m^2/(Pa s)], alpha [-],
 S [1/Pa], W [m], H [m], q [Pa], nx, ny, dt [s], t_end [s], t_out (list [s]), growth [-],
-variants (list), fem (list), refine_ny (list), support_factor [-].
+variants (list), fem (list), refine_ny (list), support_factor [-], bc_method (transformation |
+nitsche), solver (auto | mumps | fieldsplit, which needs bc_method=nitsche).
 
     python -m rkfx.cases.terzaghi [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
         [--checkpoint-every N] [--resume DIR]
@@ -55,7 +56,7 @@ from rkfx.errors import InputError
 from rkfx.geometry.particles import structured
 from rkfx.models.poroelasticity import VARIANTS, PoroMaterial, solve_biot
 from rkfx.solvers.integrate import time_grid
-from rkfx.cases import _cli, _paraview, _preflight
+from rkfx.cases import _cli, _paraview, _preflight, _up_solver
 from rkfx.cases._cli import Param, Results, Run
 from rkfx.report.claims import Claim
 
@@ -83,6 +84,7 @@ PARAMS = {
     "fem": Param(list(FEM_ELEMENTS), "FEM elements: taylor-hood, q1q1, q1q1-fpp", fingerprint=False),
     "refine_ny": Param([21, 41, 81], "nodes along the height of the refinement study [count]", fingerprint=False),
     "support_factor": Param(1.5, "RK support radius / nodal spacing [-], > 1"),
+    **_up_solver.PARAMS,
 }
 QUICK = {"refine_ny": [21, 41], "fem": ["taylor-hood", "q1q1-fpp"]}
 
@@ -98,7 +100,8 @@ def _times(t_out) -> list[float]:
     return times
 
 
-def _check(W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny, support_factor=1.5):
+def _check(W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny, support_factor=1.5,
+           bc_method="transformation", solver="auto"):
     for name, v in (("W", W), ("H", H), ("dt", dt)):
         if not v > 0:
             raise InputError(f"{name} = {v!r} must be positive")
@@ -116,12 +119,14 @@ def _check(W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny, 
     _preflight.known(variants, VARIANTS, "RKPM variant")
     _preflight.known(fem, FEM_ELEMENTS, "FEM element")
     _preflight.support_factor_ok(support_factor)
+    _up_solver.check(bc_method, solver)
 
 
 def check(*, E, nu, k, alpha, S, W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny,
-          support_factor, **_) -> None:
+          support_factor, bc_method="transformation", solver="auto", **_) -> None:
     """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
-    _check(W, H, q, nx, ny, dt, t_end, _times(t_out), growth, variants, fem, refine_ny, support_factor)
+    _check(W, H, q, nx, ny, dt, t_end, _times(t_out), growth, variants, fem, refine_ny, support_factor, bc_method,
+           solver)
     PoroMaterial(E, nu, k, alpha, S)
 
 
@@ -137,9 +142,10 @@ def memory_need(methods, *, nx, ny, refine_ny, **_) -> _preflight.Need:
                                 "lower nx, ny or refine_ny")
 
 
-def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_factor, io, vtk=None):
+def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_factor, io, vtk=None, up=None):
     """Pressure at the samples for each output time, wall time and unknowns; with ``vtk`` a
-    folder, the fields at the output times are also written there for ParaView."""
+    folder, the fields at the output times are also written there for ParaView; ``up``: the RKPM
+    solver options (``bc_method``, ``solver``)."""
     # Fixed bottom, rollers on the sides, the load q on the drained top: for RKPM and FEM alike.
     bcs = [Displacement("bottom"), Displacement("left", components=(0,)), Displacement("right", components=(0,)),
            Pressure("top"),
@@ -149,7 +155,8 @@ def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_f
         kinds = split(bcs)
         sol = solve_biot(p, material, times, outputs, displacements=kinds[Displacement], pressures=kinds[Pressure],
                          tractions=kinds[Traction], variant=method[5:], support_factor=support_factor,
-                         comm=_cli.comm(), progress=lambda it: _cli.progress(it, method, len(times) - 1), **io)
+                         comm=_cli.comm(), progress=lambda it: _cli.progress(it, method, len(times) - 1), **io,
+                         **(up or {}))
         if vtk is not None:
             _paraview.write_biot(vtk, method, p, sol, material.elastic, _cli.comm())
         return sol.pressure(samples), sol.wall_time_s, sol.n_dofs
@@ -171,12 +178,13 @@ def _solve(method, W, H, nx, ny, material, q, times, outputs, samples, support_f
 
 def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e3, nu=0.0, k=1.0e-9, alpha=1.0, S=0.0, W=3.0, H=10.0,
         q=1.0e3, nx=7, ny=21, dt=1.0, t_end=1.0, t_out=(), growth=1.5, variants=VARIANTS, fem=FEM_ELEMENTS,
-        refine_ny=(21, 41, 81), support_factor=1.5, checkpoint_every=0, work_dir=None, resume=None,
-        vtk=None) -> Results:
+        refine_ny=(21, 41, 81), support_factor=1.5, bc_method="transformation", solver="auto", checkpoint_every=0,
+        work_dir=None, resume=None, vtk=None) -> Results:
     """Both studies for every requested method; see the module docstring. ``vtk``: a folder for
     the ParaView files of the variants study's runs (``--vtk``)."""
     t_out = _times(t_out)
-    _check(W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny, support_factor)
+    _check(W, H, q, nx, ny, dt, t_end, t_out, growth, variants, fem, refine_ny, support_factor, bc_method, solver)
+    up = {"bc_method": bc_method, "solver": solver}
     material = PoroMaterial(E, nu, k, alpha, S)
     ck = _cli.Checkpoints(checkpoint_every, work_dir, resume)
     exact = Terzaghi(E, nu, k, H, q, alpha, S)
@@ -194,12 +202,13 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e3, nu=0.0, k=1.0e-9, 
              ([f"fem-{e}" for e in fem] if "fem" in methods else [])
     results = Results(NAME, dict(E=E, nu=nu, k=k, alpha=alpha, S=S, W=W, H=H, q=q, nx=nx, ny=ny, dt=dt, t_end=t_end,
                                  t_out=list(t_out), growth=growth, variants=list(variants), fem=list(fem),
-                                 refine_ny=list(refine_ny), support_factor=support_factor, p0=p0, c_v=exact.c_v,
+                                 refine_ny=list(refine_ny), support_factor=support_factor, bc_method=bc_method,
+                                 solver=solver, p0=p0, c_v=exact.c_v,
                                  steps=len(times) - 1))
     for label in labels:
         with _cli.model_run(label):
             p_h, wall, dofs = _solve(label, W, H, nx, ny, material, q, times, outputs, samples, support_factor,
-                                     ck.for_run(label), vtk)
+                                     ck.for_run(label), vtk, up)
         first = p_h[0] / p0
         errors = {"first_step_max_dev_away": float(np.abs(first - p_exact[0] / p0)[away].max()),
                   "first_step_overshoot": float(first.max() - 1.0),
@@ -215,7 +224,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e3, nu=0.0, k=1.0e-9, 
             mx = _refined_nx(nx, ny, n)
             with _cli.model_run(f"{label} ny={n}"):
                 p_h, wall, dofs = _solve(label, W, H, mx, n, material, q, np.array([0.0, dt]), [dt], samples,
-                                         support_factor, ck.for_run(f"{label}-ny{n}"))
+                                         support_factor, ck.for_run(f"{label}-ny{n}"), up=up)
             results.runs.append(Run(f"{label} ny={n}", wall, dofs,
                                     series={"z": z, "t": [dt], "p": p_h, "p_exact": p_exact[:1]},
                                     errors={"first_step_l2": float(np.linalg.norm(p_h[0] - p_exact[0])

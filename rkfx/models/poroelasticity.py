@@ -46,6 +46,7 @@ from rkfx.conditions import Displacement, Flux, Pressure, Traction, values
 from rkfx.errors import InputError
 from rkfx.geometry.cells import cell_measures, nodal_cells
 from rkfx.geometry.nodal_domains import NodalDomains
+from rkfx.assembly.galerkin import mixed_form
 from rkfx.assembly.operators import laplacian, mass, stiffness
 from rkfx.geometry.particles import Particles
 from rkfx.linalg.linear_solver import DisplacementSplit, Factorizations
@@ -62,6 +63,28 @@ from rkfx.solvers.newmark import backward_euler
 from rkfx.approximation.sparse_rows import SparseRows, combine_rows
 
 VARIANTS = ("ni", "scni", "ni+fpp", "scni+fpp")
+SOLVER_CHOICES = ("auto", "mumps", "fieldsplit")
+
+# solver="auto" factorizes by MUMPS up to this many unknowns and takes the Schur field split
+# (GMRES, GAMG on u, fixed stress) above, for 2-D Nitsche displacement conditions. Measured on
+# Mandel (bench/biot_solvers.py, five steps of one size, 2026-12-05), MUMPS / field split:
+# 49k unknowns 2.1 / 2.4 s, 0.93 / 0.62 GB; 195k 11.6 / 10.1 s, 3.5 / 1.8 GB; 383k 31.1 / 20.9 s,
+# 7.1 / 3.2 GB; at 773k MUMPS ran out of memory. Below the switch MUMPS is as fast and its later
+# solves of the same step size cost little; above it its fill takes more than twice the memory.
+# The transformation method's collocated conditions and 3-D stay direct (on the 3-D sphere of
+# rkfx.cases.cryer the split took 130 GMRES iterations per step, 14 times MUMPS's time).
+U_P_AUTO_DIRECT_MAX_DOFS = 300_000
+
+
+def choose_solver(solver: str, n_dofs: int, bc_method: str, dim: int) -> str:
+    """The linear solver of the u-p steps that ``solver="auto"`` stands for (see
+    ``U_P_AUTO_DIRECT_MAX_DOFS``); any other choice is returned as it is."""
+    if solver not in SOLVER_CHOICES:
+        raise InputError(f"unknown u-p solver {solver!r}; choose one of {', '.join(SOLVER_CHOICES)}")
+    if solver != "auto":
+        return solver
+    split = bc_method == "nitsche" and dim == 2 and n_dofs > U_P_AUTO_DIRECT_MAX_DOFS
+    return "fieldsplit" if split else "mumps"
 
 
 @dataclass(frozen=True)
@@ -307,7 +330,7 @@ def biot_operators(p: Particles, rk: RKApproximation, domains: NodalDomains, mat
     kuu = stiffness(it.gradient_quads, it.at_points(fields.D, material.elastic.voigt(dim), gradients=True))
     # Coupling (3.57): nodal points only.
     alpha = material.alpha if fields.alpha is None else np.asarray(fields.alpha, float)[mine]
-    kup = (divergence_matrix(nodal).T @ sp.diags(alpha * nodal.weights) @ nodal.values.matrix()).tocsr()
+    kup = mixed_form(nodal.gradients, nodal.values, alpha * nodal.weights)
     ks = mass(quads, it.at_points(fields.S, material.S)) if (material.S > 0 or fields.S is not None) \
         else sp.csr_matrix((n, n))
     kh = laplacian(it.gradient_quads, it.at_points(fields.k, material.k, gradients=True))
@@ -513,7 +536,7 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
                tractions: Sequence[Traction] = (), fluxes: Sequence[Flux] = (),
                variant: str = "scni+fpp", support_factor: float = 1.5,
                gravity: Sequence[float] | None = None, density: float = 0.0, fluid_density: float = 0.0,
-               comm=None, solver: str = "mumps", progress: Callable | None = None,
+               comm=None, solver: str = "auto", progress: Callable | None = None,
                rk: RKApproximation | None = None, domains: NodalDomains | None = None,
                fields: NodalFields | None = None, checkpoint_every: int = 0, checkpoint_dir=None,
                resume=None, distributed: bool | None = None, bc_method: str = "transformation",
@@ -537,7 +560,10 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
             [m/s^2]; ``None`` for none.
         density: Mixture density rho = n_f rho_f + (1 - n_f) rho_s [kg/m^3] (body force rho g).
         fluid_density: rho_f [kg/m^3] (Darcy flux -k (grad p - rho_f g), eq. 3.10).
-        comm, solver: Passed to the linear solver (PETSc when installed).
+        comm: MPI communicator of the linear solves (PETSc when installed).
+        solver: ``auto`` (MUMPS up to ``U_P_AUTO_DIRECT_MAX_DOFS`` unknowns, the field split above
+            with 2-D Nitsche conditions), ``mumps`` or ``fieldsplit`` (needs ``bc_method="nitsche"``).
+            The solver used and its iterations: ``BiotSolution.linear``.
         progress: Optional wrapper of the step iterator (e.g. a progress bar).
         rk: The RK approximation of u and p (default: linear basis, support
             ``support_factor`` h_I, no cracks).
@@ -571,10 +597,11 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
     if bc_method not in BC_METHODS:
         raise InputError(f"unknown bc_method {bc_method!r}; choose one of {', '.join(BC_METHODS)}")
     nitsche = bc_method == "nitsche"
+    g = p.x.shape[1]
+    solver = choose_solver(solver, (g + 1) * p.num_nodes, bc_method, g)
     if solver == "fieldsplit" and not nitsche:
         raise InputError("solver='fieldsplit' preconditions the displacement block by multigrid, which needs the "
                          "displacement conditions in it: use bc_method='nitsche'")
-    g = p.x.shape[1]
     if nitsche and fields is not None and (fields.D is not None or fields.alpha is not None):
         raise InputError("bc_method='nitsche' takes the material's constant D and alpha on the boundary; per-particle "
                          "fields D or alpha need bc_method='transformation'")
