@@ -145,6 +145,9 @@ CASE_FILES = {
     "injection": (["h=0.05"], {"rkpm_h0.05_particles.pvd": (("displacement", "pressure", "damage", "crack_opening",
                                                               "strain", "permeability"), ()),
                                "rkpm_h0.05_cells.pvd": ((), ("pressure", "damage"))}),
+    "cryer": (["variants=scni+fpp", "early_variants=scni+fpp", "rkpm_levels=0.1", "fem_levels=0.1"],
+              {"rkpm-scni+fpp_particles.pvd": (RK, ()), "rkpm-scni+fpp_cells.pvd": (RK, ()),
+               "fem-taylor-hood.pvd": (("displacement", "pressure"), ())}),
 }
 
 
@@ -182,7 +185,7 @@ def test_case_vtk_files_hold_the_documented_fields(case, tmp_path, capsys):
         edge = (parts.points[:, 0] < 1e-12) & (parts.points[:, 1] < 0.02)
         np.testing.assert_allclose(parts.point_data["velocity"][edge, 0], 16.5, rtol=1e-6)
     cells = next(out.glob("vtk/*_cells.pvd"), None)
-    if cells is not None and case != "plate_with_hole":  # the rectangular models: cells tile the box
+    if cells is not None and case not in ("plate_with_hole", "cryer"):  # rectangles: the cells tile the box
         _, mesh = _read(cells, times_of(cells)[-1])
         lo, hi = np.asarray(mesh.bounds[::2][:2]), np.asarray(mesh.bounds[1::2][:2])
         assert mesh.area == pytest.approx(np.prod(hi - lo), rel=1e-9)
@@ -200,3 +203,28 @@ def test_render_draws_a_field_off_screen_and_names_the_missing_one(tmp_path):
     assert rgb.std(axis=0).max() > 20  # not one flat colour: the damaged half shows
     with pytest.raises(InputError, match="no field 'pressure'; choose from damage"):
         render(tmp_path / "run_cells.pvd", "pressure", tmp_path / "x.png")
+
+
+def test_3d_particles_and_tetrahedra_read_back_and_render(tmp_path):
+    """3-D particles: vectors and Voigt tensors (xx, yy, zz, yz, xz, xy) as ParaView's symmetric
+    tensors, the tetrahedra carrying the fields as point data; the solid renders from (-1, -1, -1)."""
+    from rkfx.geometry.particles3d import box
+    from rkfx.output.render import render
+
+    p = box(1.0, 1.0, 1.0, 4, 4, 4)
+    series = FieldSeries(tmp_path, "solid", p.x, cells=p.tetrahedra)
+    voigt = np.column_stack([p.x, 10 + p.x])  # xx, yy, zz, yz, xz, xy
+    series.write(0.5, displacement=0.1 * p.x, pressure=p.x.sum(axis=1), stress=voigt)
+    _, mesh = _read(series.pvd, 0.5)
+    np.testing.assert_allclose(mesh.points, p.x)
+    np.testing.assert_allclose(mesh.point_data["displacement"], 0.1 * p.x)
+    np.testing.assert_allclose(mesh.point_data["stress"], voigt[:, [0, 1, 2, 5, 3, 4]])  # xx yy zz xy yz xz
+    _, solid = _read(tmp_path / "solid_cells.pvd", 0.5)
+    assert solid.volume == pytest.approx(1.0) and solid.n_cells == len(p.tetrahedra)
+    np.testing.assert_allclose(solid.point_data["pressure"], p.x.sum(axis=1))
+    png = render(tmp_path / "solid_cells.pvd", "pressure", tmp_path / "p.png", view="iso-")
+    image = pv.read(str(png))
+    rgb = np.asarray(image.point_data[image.point_data.keys()[0]])[:, :3].astype(float)
+    assert rgb.std(axis=0).max() > 20
+    with pytest.raises(InputError, match="view 'top'"):
+        render(tmp_path / "solid_cells.pvd", "pressure", tmp_path / "q.png", view="top")

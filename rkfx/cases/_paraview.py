@@ -14,16 +14,20 @@ from rkfx.output.paraview import FieldSeries, MeshSeries, among, nodal_cells
 def write_biot(folder: Path, label: str, particles, sol, elastic, comm=None, times=None) -> FieldSeries:
     """A u-p solution (``rkfx.models.poroelasticity.BiotSolution``) at its output times (or at
     those of them in ``times`` [s]): displacement [m], pressure [Pa], strain tensor [-] and
-    effective stress D eps(u^h) [Pa] at the particles, with the particles' median-dual cells."""
-    series = FieldSeries(folder, label, particles.x, cells=nodal_cells(particles), comm=comm)
+    effective stress D eps(u^h) [Pa] at the particles, with the particles' median-dual cells (in
+    3-D: their tetrahedra, the fields as point data)."""
+    dim = particles.x.shape[1]
+    cells = nodal_cells(particles) if dim == 2 else particles.tetrahedra
+    series = FieldSeries(folder, label, particles.x, cells=cells, comm=comm)
     if series.writes:
         u, p, eps = sol.displacement(particles.x), sol.pressure(particles.x), sol.strain(particles.x)
-        D = elastic.D()
+        D = elastic.voigt(dim)
+        # Engineering shears to the tensor's components (eps_xy = gamma_xy / 2).
+        halve = [1.0, 1.0, 0.5] if dim == 2 else [1.0, 1.0, 1.0, 0.5, 0.5, 0.5]
         for k, t in enumerate(sol.times):
             if times is not None and not among(t, times):
                 continue
-            tensor = eps[k] * [1.0, 1.0, 0.5]  # engineering gamma_xy to the tensor's eps_xy
-            series.write(t, displacement=u[k], pressure=p[k], strain=tensor, effective_stress=eps[k] @ D.T)
+            series.write(t, displacement=u[k], pressure=p[k], strain=eps[k] * halve, effective_stress=eps[k] @ D.T)
     return series
 
 

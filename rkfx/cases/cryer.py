@@ -43,7 +43,12 @@ rkpm_levels (list) [m], fem_levels (list) [m], support_factor [-], bc_method (tr
 nitsche), solver (auto | mumps | fieldsplit, which needs bc_method=nitsche; in 3-D auto is MUMPS).
 
     python -m rkfx.cases.cryer [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
-        [--checkpoint-every N] [--resume DIR]
+        [--checkpoint-every N] [--resume DIR] [--vtk]
+
+With ``--vtk`` the history runs write displacement, pressure, strain and effective stress at the
+times ``t_D`` to OUT/vtk/ (RKPM: the particles and their tetrahedra with the fields as point
+data; FEM: dolfinx VTK files), e.g.
+``python -m rkfx.output.render OUT/vtk/rkpm-scni+fpp_cells.pvd --field pressure --view iso-``.
 
 With ``--checkpoint-every N`` every run writes its state every N steps to OUT/checkpoints/;
 ``--resume DIR`` continues an interrupted invocation.
@@ -57,7 +62,7 @@ import numpy as np
 
 from verification.cryer import Cryer
 
-from rkfx.cases import _cli, _preflight, _up_solver
+from rkfx.cases import _cli, _paraview, _preflight, _up_solver
 from rkfx.cases._cli import Param, Results, Run
 from rkfx.conditions import Displacement, Pressure, Traction
 from rkfx.errors import InputError
@@ -179,9 +184,9 @@ def _geometry(radius: float, size: float, fem: bool):
     return particles, mesh
 
 
-def _rkpm(p, material, bcs, times, variant, support_factor, samples, key, ck, up):
+def _rkpm(p, material, bcs, times, variant, support_factor, samples, key, ck, up, vtk=None, vtk_times=None):
     """One RKPM run: pressures at ``samples`` at every step, wall time, unknowns; ``up``: the solver
-    options (``bc_method``, ``solver``)."""
+    options (``bc_method``, ``solver``); with ``vtk`` a folder, its fields at ``vtk_times`` [s]."""
     kind = {Displacement: [], Pressure: [], Traction: []}
     for c in bcs:
         kind[type(c)].append(c)
@@ -189,17 +194,27 @@ def _rkpm(p, material, bcs, times, variant, support_factor, samples, key, ck, up
         sol = solve_biot(p, material, times, times[1:], kind[Displacement], kind[Pressure], kind[Traction],
                          variant=variant, support_factor=support_factor, comm=_cli.comm(),
                          progress=lambda it: _cli.progress(it, key, len(times) - 1), **ck.for_run(key), **up)
+    if vtk is not None:
+        _paraview.write_biot(vtk, key.removesuffix("-history"), p, sol, material.elastic, _cli.comm(), vtk_times)
     return sol.pressure(samples), sol.wall_time_s, sol.n_dofs
 
 
-def _fem(mesh, material, bcs, times, element, samples, key, ck):
+def _fem(mesh, material, bcs, times, element, samples, key, ck, vtk=None, vtk_times=None):
     from fem_baselines import poroelasticity as fb  # noqa: PLC0415
 
+    series = _paraview.fem_series(vtk, key.removesuffix("-history"), mesh.mesh, vtk_times)
     with _cli.model_run(key):
         res = fb.solve_biot(mesh, material.E, material.nu, material.k, material.alpha, material.S, element, bcs,
-                            times, samples, times[1:], comm=_cli.comm(),
+                            times, samples, times[1:], comm=_cli.comm(), vtk=series,
                             progress=lambda it: _cli.progress(it, key, len(times) - 1), **ck.for_run(key))
+    if series is not None:
+        series.close()
     return res.p, res.wall_time_s, res.n_dofs
+
+
+def _shown(key: str, vtk, times) -> tuple:
+    """(folder, times) of the ParaView files of a history run; nothing for the other runs."""
+    return (vtk, times) if vtk is not None and key.endswith("-history") else (None, None)
 
 
 def _history_errors(run_: Run, exact: Cryer, T: np.ndarray, centre: np.ndarray, t_D) -> None:
@@ -217,8 +232,10 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, 
         load=1.0, mesh_size=0.05, dt_D=1.0e-3, growth=2.0, hold=20, max_dt_D=5.0e-3, t_D=(0.01, 0.05, 0.1, 0.3, 0.6),
         variants=("scni+fpp", "ni"), early_variants=VARIANTS, early_dt_D=1.0e-3, early_steps=10,
         fem=FEM_ELEMENTS, rkpm_levels=(0.1, 0.07, 0.05), fem_levels=(0.2, 0.14, 0.1, 0.07), support_factor=1.5,
-        bc_method="transformation", solver="auto", checkpoint_every=0, work_dir=None, resume=None) -> Results:
-    """The three studies for every requested method; see the module docstring."""
+        bc_method="transformation", solver="auto", checkpoint_every=0, work_dir=None, resume=None,
+        vtk=None) -> Results:
+    """The three studies for every requested method; see the module docstring. ``vtk``: a folder for
+    the ParaView files of the history runs at the times ``t_D`` (``--vtk``)."""
     _check(E=E, nu=nu, k=k, alpha=alpha, S=S, radius=radius, load=load, mesh_size=mesh_size, dt_D=dt_D,
            growth=growth, hold=hold, max_dt_D=max_dt_D, t_D=t_D, variants=variants, early_variants=early_variants,
            early_dt_D=early_dt_D, early_steps=early_steps, fem=fem, rkpm_levels=rkpm_levels, fem_levels=fem_levels,
@@ -253,11 +270,12 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e4, nu=0.0, k=1.0e-4, 
         for v in dict.fromkeys(list(variants) + list(early_variants)):
             solvers.append((f"rkpm-{v}", v in variants, v in early_variants,
                             lambda tt, key, v=v: _rkpm(p, material, bcs, tt, v, support_factor, samples, key, ck,
-                                                       up)))
+                                                       up, *_shown(key, vtk, t_out * scale))))
     if want_fem:
         for e in fem:
             solvers.append((f"fem-{e}", True, True,
-                            lambda tt, key, e=e: _fem(mesh, material, bcs, tt, e, samples, key, ck)))
+                            lambda tt, key, e=e: _fem(mesh, material, bcs, tt, e, samples, key, ck,
+                                                      *_shown(key, vtk, t_out * scale))))
     done = {}  # (method, mesh size) -> the history's (pressures, wall, unknowns), reused by the refinement
     for label, history, early, solve in solvers:
         run_ = Run(label, 0.0, 0, series={"r": r},

@@ -11,7 +11,9 @@ every step, so a run that stops keeps every step it wrote. Fields are per partic
 ``(n,)`` scalars, ``(n, 2)`` vectors (written with a zero z component) and ``(n, 3)`` plane
 tensors in Voigt order (xx, yy, xy), written as ParaView's symmetric tensors (xx, yy, zz, xy,
 yz, xz) with zero out-of-plane components. Under MPI only rank 0 writes (the fields are whole
-there).
+there). 3-D particles (points ``(n, 3)``) take ``(n, 3)`` vectors and ``(n, 6)`` tensors in the
+Voigt order (xx, yy, zz, yz, xz, xy), and as cells their tetrahedra ``(m, 4)``, which carry the
+particles' fields as point data (``NAME_cells.pvd``: the solid, coloured continuously).
 
     series = FieldSeries("out/vtk", "rkpm", particles.x, cells=nodal_cells(particles))
     series.write(0.5, displacement=u, pressure=p)
@@ -48,13 +50,20 @@ def nodal_cells(p: Particles | NodalDomains) -> CellGeometry:
     return cell_geometry(p)
 
 
-def _vtk_values(name: str, a: np.ndarray, n: int) -> np.ndarray:
+def _vtk_values(name: str, a: np.ndarray, n: int, dim: int = 2) -> np.ndarray:
     a = np.asarray(a, float)
     if a.shape[0] != n or a.ndim > 2:
-        raise InputError(f"field {name!r} has shape {a.shape}; give one value, vector (2) or Voigt tensor (3) "
-                         f"per particle ({n})")
+        raise InputError(f"field {name!r} has shape {a.shape}; give one value, vector ({dim}) or Voigt tensor "
+                         f"({3 if dim == 2 else 6}) per particle ({n})")
     if a.ndim == 1 or a.shape[1] == 1:
         return a.reshape(n)
+    if dim == 3:
+        if a.shape[1] == 3:
+            return a
+        if a.shape[1] == 6:  # Voigt (xx, yy, zz, yz, xz, xy) -> ParaView's (xx, yy, zz, xy, yz, xz)
+            return a[:, [0, 1, 2, 5, 3, 4]]
+        raise InputError(f"field {name!r} has {a.shape[1]} components; give 1, 3 (vector) or 6 "
+                         "(xx, yy, zz, yz, xz, xy) in 3-D")
     if a.shape[1] == 2:
         return np.column_stack([a, np.zeros(n)])
     if a.shape[1] == 3:
@@ -84,12 +93,14 @@ class FieldSeries:
     Args:
         folder: Output folder (created).
         name: Prefix of the files, e.g. the run's method label.
-        points: Particle coordinates, shape ``(n, 2)`` [m].
-        cells: The nodal cells (``nodal_cells``), or ``None`` to write the particles only.
+        points: Particle coordinates, shape ``(n, 2)`` or ``(n, 3)`` [m].
+        cells: The nodal cells (``nodal_cells``), or in 3-D the tetrahedra ``(m, 4)`` of the
+            particles, or ``None`` to write the particles only.
         comm: MPI communicator; only its rank 0 writes. ``None``: this process writes.
     """
 
-    def __init__(self, folder, name: str, points: np.ndarray, cells: CellGeometry | None = None, comm=None):
+    def __init__(self, folder, name: str, points: np.ndarray, cells: CellGeometry | np.ndarray | None = None,
+                 comm=None):
         self.folder, self.name = Path(folder), file_stem(name)
         self.points = np.asarray(points, float)
         self.cells = cells
@@ -109,13 +120,16 @@ class FieldSeries:
             return
         import meshio  # noqa: PLC0415  (an output dependency, loaded when output is asked for)
 
-        n = len(self.points)
-        values = {k: _vtk_values(k, v, n) for k, v in fields.items()}
+        n, dim = self.points.shape
+        values = {k: _vtk_values(k, v, n, dim) for k, v in fields.items()}
         k = len(self.entries["particles"])
-        xyz = np.column_stack([self.points, np.zeros(n)])
+        xyz = self.points if dim == 3 else np.column_stack([self.points, np.zeros(n)])
         self._write(meshio.Mesh(xyz, [("vertex", np.arange(n).reshape(-1, 1))], point_data=values),
                     "particles", k, time)
-        if self.cells is not None:
+        if self.cells is not None and dim == 3:
+            self._write(meshio.Mesh(xyz, [("tetra", np.asarray(self.cells, np.int64))], point_data=values),
+                        "cells", k, time)
+        elif self.cells is not None:
             m = len(self.cells.node)
             corners = np.column_stack([self.cells.vertices.reshape(-1, 2), np.zeros(4 * m)])
             data = {key: [v[self.cells.node]] for key, v in values.items()}
