@@ -1,7 +1,8 @@
 """Exact and manufactured solutions, vectorised functions of (x, t), with references.
 
     kirsch         infinite plane-strain plate with a circular hole under remote uniaxial tension
-    manufactured   manufactured plane-strain fields (sine field with its body force; linear patch)
+    manufactured   manufactured elastic fields, plane strain and 3-D (sine fields with their body
+                   forces; linear patch)
     terzaghi       1-D consolidation of a column (Fourier and short-time erfc series), general Biot
     mandel         Mandel's squeezed slab (Abousleiman et al. 1996), general Biot, S = 0 explicit
     strip_load     strip load on a drained poroelastic half-plane (Schiffman, Chen & Jordan 1969),
@@ -12,4 +13,8 @@
                    Wei 2018 eq. 5.37)
     wave_column    step-loaded saturated u-p column with inertia (Wei 2018 §6.4.1): Laplace domain,
                    Fourier-series inversion; the undrained rod in closed form
+    cryer          Cryer's poroelastic sphere under a sudden load (Cryer 1963), general Biot:
+                   residue series and Talbot inversion
+    crossing       does a hydraulic fracture cross a frictional interface? Renshaw-Pollard (1995),
+                   a construction after Gu-Weng (2010), Blanton's tests (Wei 2018 Table 5.1)
 """
