@@ -35,6 +35,7 @@ data path (see docs/core.md):
     fracture        the damage particle method (chapter 4)
         damage           damage points: regularization by the cell chord (4.28), trial updates
         tracking         candidate damage particles along crack segments (eq. 4.22)
+        history          trial and committed damage of implicit models, with tracking admissions
     models          what the steppers advance
         elastostatics    elastostatics in 2-D and 3-D
         poroelasticity   equal-order u-p Biot model: NI/SCNI with pressure projection (chapter 3),

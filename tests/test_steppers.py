@@ -252,3 +252,45 @@ def test_resume_is_reported_and_a_garbled_checkpoint_named(tmp_path, caplog):
     path.write_bytes(path.read_bytes()[:40])  # truncated, as by a full disk
     with pytest.raises(InputError, match=r"checkpoint.npz is unreadable .*delete .*run"):
         load_arrays(tmp_path / "run")
+
+
+class SlowlyLoaded(Oscillator):
+    """m x'' + k x + k3 x^3 = F t: a stiff Duffing spring loaded slowly, quasi-static on the scale
+    of its period (the steps are 1e4 periods)."""
+
+    def __init__(self):
+        super().__init__(m=1e-6, k=1.0, k3=50.0)
+        self.linear = False
+
+    def residual(self, x, t):
+        return super().residual(x, t) - t
+
+
+def test_damped_newmark_is_first_order_and_damps_what_the_trapezoid_keeps():
+    model = Oscillator()
+    omega = np.sqrt(model.k / model.m)
+    errs = [abs(run(nm.damped(), model, 2.0, n, [1.0]).x[0] - np.cos(omega * 2.0)) for n in (160, 320, 640, 1280)]
+    assert np.all(rates(errs) > 0.85), errs
+    # Steps of 100 periods: the trapezoid keeps the amplitude (1), the damped scheme kills it.
+    dt = 100 * 2 * np.pi / omega
+    kept = run(nm.trapezoidal(), model, 20 * dt, 20, [1.0])
+    damped = run(nm.damped(), model, 20 * dt, 20, [1.0])
+    assert abs(kept.x[0]) > 0.9 and abs(damped.x[0]) < 0.1  # measured: 0.865 per step
+    with pytest.raises(InputError, match="gamma = 0.5"):
+        nm.damped(gamma=0.5)
+
+
+def test_newton_from_the_last_step_finds_the_same_solution_in_fewer_iterations():
+    """guess="previous": the same trapezoidal steps of a slowly loaded stiff spring, Newton
+    started from x_n instead of the predictor, which the undamped stiff mode carries off."""
+    times = np.linspace(0.0, 2.0, 21)
+    out = {}
+    for guess in ("predictor", "previous"):
+        st = nm.trapezoidal(guess=guess, rtol=1e-12)
+        rec = Final()
+        res = integrate(st, SlowlyLoaded(), times, start=st.start(SlowlyLoaded(), x0=[0.0], a0=[0.0]), recorder=rec)
+        out[guess] = (np.array(rec.x), res.newton_iterations)
+    assert np.allclose(out["previous"][0], out["predictor"][0], rtol=1e-9, atol=1e-12)
+    assert out["previous"][1] < out["predictor"][1], out
+    with pytest.raises(InputError, match="guess"):
+        nm.Newmark(guess="zero")

@@ -151,9 +151,19 @@ def memory_need(methods, *, L, h, **_) -> _preflight.Need:
     return _preflight.need(RKPM_BYTES_PER_NODE, nodes, f"h={min(h):g}", "raise h")
 
 
+ROCK_FIELDS = ("E", "nu", "rho_s", "rho_w", "porosity", "k_h", "gamma_w", "K_w", "K_s", "GF", "ft", "viscosity", "alpha")
+
+
 def _rock(**m) -> FracturingRock:
-    return FracturingRock(m["E"], m["nu"], m["rho_s"], m["rho_w"], m["porosity"], m["k_h"], m["gamma_w"], m["K_w"],
-                          m["K_s"], m["GF"], m["ft"], m["viscosity"], m["alpha"])
+    return FracturingRock(**{k: m[k] for k in ROCK_FIELDS})
+
+
+def default_rock(**overrides) -> FracturingRock:
+    """The case's rock (the defaults of ``PARAMS``, seed 5.3.2), any field replaced by ``overrides``."""
+    unknown = sorted(set(overrides) - set(ROCK_FIELDS))
+    if unknown:
+        raise InputError(f"default_rock: no field {unknown[0]!r}; give one of {', '.join(ROCK_FIELDS)}")
+    return _rock(**({k: PARAMS[k].default for k in ROCK_FIELDS} | overrides))
 
 
 def onset_estimates(rock: FracturingRock, c: float, rate: float) -> dict:

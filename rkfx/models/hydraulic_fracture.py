@@ -30,7 +30,7 @@ Pre-existing cracks (a notch) enter as particles damaged from the start (``initi
 D = 1 with their crack normal, fluid pressure prescribed on them by a ``Region`` condition.
 """
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -42,6 +42,7 @@ from rkfx.assembly.smeared_strain import lumped_mass, row_strains
 from rkfx.conditions import Displacement, Flux, Pressure, Region, Traction
 from rkfx.errors import InputError
 from rkfx.fracture import damage as dm
+from rkfx.fracture.history import DamageHistory
 from rkfx.fracture.tracking import Tracking
 from rkfx.geometry.nodal_domains import NodalDomains
 from rkfx.geometry.particles import Particles
@@ -159,7 +160,7 @@ def initial_damage(points: dm.DamageModel, cracked: np.ndarray, normal: Sequence
 JACOBIANS = ("symmetric", "full")
 
 
-class HydraulicFractureModel:
+class HydraulicFractureModel(DamageHistory):
     """The model of the module docstring on particles ``p`` with nodal domains ``domains``.
 
     Args:
@@ -405,60 +406,9 @@ class HydraulicFractureModel:
         n = self.n
         return np.r_[np.ones(2 * n), np.full(n, -1.0 / co.dv[0])]
 
-    MAX_TRACKING_ROUNDS = 1000  # admissions within one residual (each admits at least one particle)
-
     def _damage(self, eps: np.ndarray) -> dm.DamageUpdate:
-        """The trial damage of ``eps`` from the committed state, with the tracking candidates of
-        the particles initiating in it admitted until none initiates (``track``)."""
-        if self.track is None:
-            return dm.update(self.points, self.committed, eps, tangent_floor=self.residual_fraction)
-        if self._trial_tracking is None:
-            self._trial_tracking = (self.allowed.copy(), self.parent.copy())
-        allowed, parent = self._trial_tracking  # grows over the step's iterates (see ``track``)
-        upd = dm.update(self.points, self.committed, eps, tangent_floor=self.residual_fraction, allowed=allowed)
-        done = self.committed.damaged.copy()
-        for _ in range(self.MAX_TRACKING_ROUNDS):
-            new = np.flatnonzero(upd.state.damaged & ~done)
-            if new.size == 0 or not self._admit(new, upd.state.normal, allowed, parent):
-                break
-            done[new] = True
-            upd = dm.update(self.points, self.committed, eps, tangent_floor=self.residual_fraction, allowed=allowed)
-        return upd
-
-    def _admit(self, new: np.ndarray, normal: np.ndarray, allowed: np.ndarray, parent: np.ndarray) -> bool:
-        """Allow, in place, the tracking candidates (4.22) of the particles ``new`` that
-        initiated with ``normal``; whether any was not allowed before."""
-        if self.track is None or new.size == 0:
-            return False
-        cand, by = self.track.candidates(new, normal[new], parent)
-        fresh = ~allowed[cand]
-        allowed[cand] = True
-        parent[cand[fresh]] = by[fresh]
-        return bool(fresh.any())
-
-    def commit(self) -> None:
-        self.committed = self.trial.state
-        if self.track is not None and self._trial_tracking is not None:
-            self.allowed, self.parent = self._trial_tracking
-        self._trial_tracking = None
-        dm.check_regularization(self.points, self.committed)
-        self.iterations.append(self._count)
-        self._count = 0
-
-    def state(self) -> dict[str, np.ndarray]:
-        out = {f.name: getattr(self.committed, f.name) for f in fields(dm.DamageState)} | {
-            "iterations": np.array(self.iterations, np.int64), "parent": self.parent}
-        if self.allowed is not None:
-            out["allowed"] = self.allowed
-        return out
-
-    def restore(self, arrays) -> None:
-        self.committed = dm.DamageState(**{f.name: np.array(arrays[f.name]) for f in fields(dm.DamageState)})
-        self.iterations = [int(i) for i in arrays["iterations"]]
-        self.parent = np.array(arrays["parent"], np.int64)
-        if self.allowed is not None:
-            self.allowed = np.array(arrays["allowed"], bool)
-        self._trial_tracking = None
+        """The trial damage of ``eps`` with the tracking admissions (``DamageHistory.trial_damage``)."""
+        return self.trial_damage(eps, tangent_floor=self.residual_fraction)
 
 
 def _unit(normal: np.ndarray) -> np.ndarray:

@@ -92,6 +92,9 @@ class Coefficients:
         return self.dx == 0.0
 
 
+GUESSES = ("predictor", "previous")
+
+
 @dataclass(frozen=True)
 class Newmark:
     """The Newmark/trapezoid family (see the module docstring).
@@ -108,6 +111,13 @@ class Newmark:
         ctol: ... and ||G x - g||_inf <= ctol (1 + ||g||_inf) on the constraints.
         min_iterations: Newton iterations before the test is taken (1: never accept the
             predictor untried).
+        guess: Where Newton starts: ``predictor`` (x~, the Newmark predictor) or ``previous``
+            (x_n, the last step's unknowns; explicit fields keep their predictor). The step's
+            solution is the same; the start is not. With steps far above a model's stiff
+            periods (a loading that is quasi-static on the elastic time scale) the trapezoidal
+            rule damps nothing, its velocities and accelerations alternate from step to step,
+            and x~ = x_n + dt v_n + dt^2 a_n / 4 lands ever farther from x_(n+1) (a damage model
+            then iterates through strains far past its thresholds); x_n does not.
     """
 
     beta: float = 0.25
@@ -118,8 +128,11 @@ class Newmark:
     atol: float = 0.0
     ctol: float = 1e-10
     min_iterations: int = 1
+    guess: str = "predictor"
 
     def __post_init__(self):
+        if self.guess not in GUESSES:
+            raise InputError(f"Newton's start guess = {self.guess!r}; choose one of {', '.join(GUESSES)}")
         if not 0.0 <= self.beta <= 0.5:
             raise InputError(f"Newmark beta = {self.beta!r} must lie in [0, 1/2] (1/4: trapezoidal rule)")
         if not 0.5 <= self.gamma <= 1.0:
@@ -211,7 +224,11 @@ class Newmark:
             plan = solves.memo[key] = _Plan(self, model, dt, con.G)
         co = self.coefficients(orders, dt)
         system = _NewmarkSystem(self, model, plan, co, x_t, v_t, con, t1, s.t)
-        z0 = np.r_[np.zeros(len(x_t)), s.multipliers if len(s.multipliers) == con.count else np.zeros(con.count)]
+        w0 = np.zeros(len(x_t))
+        if self.guess == "previous":  # x = x~ + dx w: start at x_n where w moves x (dx = 1)
+            moved = co.dx == 1.0
+            w0[moved] = s.x[moved] - x_t[moved]
+        z0 = np.r_[w0, s.multipliers if len(s.multipliers) == con.count else np.zeros(con.count)]
         res = newton(system, z0, solves, self.newton)
         if not res.converged:
             return None, res
@@ -435,6 +452,19 @@ def crank_nicolson(**options) -> Newmark:
 def trapezoidal(**options) -> Newmark:
     """Newmark beta = 1/4, gamma = 1/2 with theta = 1/2: the seed's choice (5.18-5.22)."""
     return Newmark(beta=0.25, gamma=0.5, theta=0.5, **options)
+
+
+def damped(gamma: float = 0.6, theta: float = 0.6, **options) -> Newmark:
+    """The Newmark family with numerical damping: gamma > 1/2 with beta = (gamma + 1/2)^2 / 4 for
+    second-order fields (the high frequencies damped, unconditionally stable), theta > 1/2 for
+    first-order ones; first order in time. For loadings that are quasi-static on the elastic
+    time scale, taken with steps far above the stiff periods: the trapezoidal rule keeps those
+    modes' oscillation undamped from step to step, this does not."""
+    if not 0.5 < gamma <= 1.0:
+        raise InputError(f"gamma = {gamma!r} must lie in (1/2, 1] (0.6: mild damping); 1/2 is the trapezoidal rule")
+    if not 0.5 < theta <= 1.0:
+        raise InputError(f"theta = {theta!r} must lie in (1/2, 1] (0.6: mild damping); 1/2 is Crank-Nicolson")
+    return Newmark(beta=(gamma + 0.5) ** 2 / 4.0, gamma=gamma, theta=theta, **options)
 
 
 def explicit(**options) -> Newmark:
