@@ -218,7 +218,7 @@ ROWS: list[Row] = [
                               ("unknown Jacobian", "jacobian=exact"), ("falling notch pressure", "rate=-1"),
                               ("map time after the end", "t_out=5000"), ("porosity 1", "porosity=1"),
                               ("tracking tolerance above 1", "tol=2")]),
-    Row("no FEM baseline yet", "injection", ("--method", "fem")),
+    Row("FEM spacing that does not divide the notch", "injection", ("--method", "fem", "--set", "fem_h=0.03")),
     Row("too big for memory", "injection", ("--set", "h=1e-5")),
     *_case_rows("wave_column", [("unknown nodal rule", "rules=nsni,fem"), ("porosity 1", "porosity=1"),
                                 ("grains softer than the skeleton", "K_s=1e8"), ("Courant number above 1", "courant=1.5"),
