@@ -8,6 +8,7 @@ data path (see docs/core.md):
         particles3d      3-D nodes with a tetrahedralization: tensor grids, jittered grids
         gmsh_nodes       particles from gmsh models and .geo files, 2-D and 3-D (needs gmsh)
         gmsh_solids      the 3-D benchmark solids as gmsh models: sphere octant, box, L-block
+        gmsh_plates      2-D squares with embedded pre-existing fractures as gmsh models
         nodal_domains    conforming median-dual cells, subcells, boundary segments
         grid_cells       rectangular Voronoi cells of tensor grids, with slits along cell faces
         nodal_cells3d    3-D cells: median-dual cells of tetrahedra, box cells of grids (13 points)
@@ -36,6 +37,7 @@ data path (see docs/core.md):
         damage           damage points: regularization by the cell chord (4.28), trial updates
         tracking         candidate damage particles along crack segments (eq. 4.22)
         history          trial and committed damage of implicit models, with tracking admissions
+        contact          pre-existing fractures: penalty frictional contact (5.38)-(5.39), their flow
     models          what the steppers advance
         elastostatics    elastostatics in 2-D and 3-D
         poroelasticity   equal-order u-p Biot model: NI/SCNI with pressure projection (chapter 3),

@@ -455,7 +455,19 @@ def cut_triangulation(p: Particles, polylines, gap: float | None = None, name: s
     side_tag[on_bnd] = p.boundary_tags[order[np.searchsorted(bkeys[order], side_keys[on_bnd])]]
     tagged = {nm: new_sides[side_tag == t] for nm, t in p.boundary_names.items()}
     tagged[name] = new_sides[np.isin(side_keys, cand[:, 0] * n + cand[:, 1])]
-    return particles(xn, new_tri, tagged, np.r_[p.spacing, extra_h]), c
+    # A crack reaching the boundary is prolonged a little beyond it, so the face copies at its end
+    # (a gap off the crack line, level with its end point) are still hidden from the other side.
+    reach = 1e-6 * scale
+    prolonged = []
+    for v, ends in zip(lines, on_boundary):
+        v = v.copy()
+        for k, (i, j) in enumerate(((0, 1), (-1, -2))):
+            if ends[k]:
+                d = v[i] - v[j]
+                v[i] = v[i] + reach * d / np.linalg.norm(d)
+        prolonged.append(v)
+    return particles(xn, new_tri, tagged, np.r_[p.spacing, extra_h]), make_cracks(
+        prolonged, [(not a, not b) for a, b in on_boundary], exponent)
 
 
 def _segment_distance(pts: np.ndarray, segments: np.ndarray) -> np.ndarray:

@@ -28,6 +28,14 @@ iterations of every accepted step is kept (``iterations``).
 
 Pre-existing cracks (a notch) enter as particles damaged from the start (``initial_damage``):
 D = 1 with their crack normal, fluid pressure prescribed on them by a ``Region`` condition.
+
+A pre-existing fracture with frictional contact (``contact``, seed 5.3.3): the particles are cut
+along it (``cut_triangulation``) and the RK approximation sees it by diffraction; its faces
+carry the fluid pressure and the penalty frictional contact (5.38)-(5.39)
+(``rkfx.fracture.contact``): f_int gains f_C, the Jacobian its derivative (unsymmetric where
+the fracture slips) and the u-p block the pressure on the faces. The particles covering it
+take its permeability (open: (5.8) with w = g_N; closed: k_f0 / 100) plus their own crack
+band's enhancement; that permeability is not differentiated in the Jacobian.
 """
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
@@ -42,6 +50,7 @@ from rkfx.assembly.smeared_strain import lumped_mass, row_strains
 from rkfx.conditions import Displacement, Flux, Pressure, Region, Traction
 from rkfx.errors import InputError
 from rkfx.fracture import damage as dm
+from rkfx.fracture.contact import FractureContact, FrictionalContact, interface
 from rkfx.fracture.history import DamageHistory
 from rkfx.fracture.tracking import Tracking
 from rkfx.geometry.nodal_domains import NodalDomains
@@ -179,6 +188,9 @@ class HydraulicFractureModel(DamageHistory):
         injection: ``(region, rate)``: fluid injected into the particles of a ``Region`` at
             ``rate(t)`` [m^3/s per unit thickness], spread over them by volume (a source in the
             storage equation, Q^ext); the alternative to prescribing the notch pressure.
+        contact: The frictional contact law of a pre-existing fracture whose faces are the
+            boundary part ``fracture`` (``cut_triangulation``'s name; the approximation ``rk``
+            must carry its cracks); ``None``: no such fracture.
         track: Particle tracking (``rkfx.fracture.tracking``): only its seeds, the damaged
             particles and the candidates (4.22) of the damaged ones may damage. Within every
             residual the particles that initiate admit their candidates at once and the
@@ -199,7 +211,8 @@ class HydraulicFractureModel(DamageHistory):
                  precracked: np.ndarray | None = None, precrack_normal: Sequence[float] = (0.0, 1.0),
                  residual: float = RESIDUAL_STIFFNESS, eps_p: float = 1.0,
                  jacobian: str = "symmetric", track: Tracking | None = None,
-                 injection: tuple[Region, Callable[[float], float]] | None = None):
+                 injection: tuple[Region, Callable[[float], float]] | None = None,
+                 contact: FrictionalContact | None = None, fracture: str = "crack"):
         if jacobian not in JACOBIANS:
             raise InputError(f"jacobian = {jacobian!r}; choose one of {', '.join(JACOBIANS)}")
         self.jacobian = jacobian
@@ -220,8 +233,11 @@ class HydraulicFractureModel(DamageHistory):
         self._div = divergence_matrix(it.nodal)
         self._bt = strain_matrix(self._grad).T.tocsr()
         self._fpp = projection_rows(rk, domains, it)
+        self.fracture = None if contact is None else FractureContact(interface(p, rk=rk, domains=domains, name=fracture),
+                                                                     contact, p.x, self.volume)
         self._C = rock.damage_material.elasticity()
-        self.points = dm.damage_model(rock.damage_material, self.volume, geometry=dm.cell_geometry(domains))
+        cells = domains if domains.subcell_vertices is not None else p  # grid cells, or median-dual cells of p
+        self.points = dm.damage_model(rock.damage_material, self.volume, geometry=dm.cell_geometry(cells))
         self.committed = initial_damage(self.points, np.zeros(0, np.int64) if precracked is None else precracked,
                                         precrack_normal)
         self.track = track if track is not None and track.enabled else None
@@ -317,7 +333,12 @@ class HydraulicFractureModel(DamageHistory):
         f_int = self._bt @ (self.volume[:, None] * stress).ravel() + self._stabilization() @ u
         alpha = self.rock.biot(st.damage)
         self._coupling = (self._div.T @ sp.diags(alpha * self.volume) @ self._values).tocsr()
-        self._kh = laplacian(it.gradient_quads, it.at_points(self.permeability(st, eps), None, gradients=True))
+        k = self.permeability(st, eps)
+        if self.fracture is not None:
+            f_int = f_int + self.fracture.forces(u, P)
+            cover, k_fracture = self.fracture.permeability(self.rock.mobility, self.rock.viscosity)
+            k[cover] += k_fracture - self.rock.mobility * np.eye(2)  # the band's enhancement stays
+        self._kh = laplacian(it.gradient_quads, it.at_points(k, None, gradients=True))
         self._P = P
         f_ext, q_ext = self._loads(t)
         return np.r_[f_int - self._coupling @ P - f_ext, self._kh @ P - q_ext]
@@ -327,8 +348,11 @@ class HydraulicFractureModel(DamageHistory):
         self._count += 1
         # (5.35) with 1 - D floored at the residual fraction, as in the stress.
         k_u = stiffness([self.nodal], [self.trial.tangent]) + self._stabilization()
+        k_up = -self._coupling
+        if self.fracture is not None:
+            k_u, k_up = k_u + self.fracture.stiffness(), k_up + self.fracture.pressure_coupling()
         k_pu = self._permeability_derivative() if self.jacobian == "full" else None
-        return sp.bmat([[k_u, -self._coupling], [k_pu, self._kh]], format="csr")
+        return sp.bmat([[k_u, k_up], [k_pu, self._kh]], format="csr")
 
     def _permeability_derivative(self) -> sp.csr_matrix | None:
         """d(K_H P)/dU (5.33) at the last residual, shape ``(n, 2 n)``, or ``None`` where no
@@ -405,6 +429,19 @@ class HydraulicFractureModel(DamageHistory):
         """-beta_2 dt / beta_1 = -1 / (du'/du) on the storage rows, as in (5.24)."""
         n = self.n
         return np.r_[np.ones(2 * n), np.full(n, -1.0 / co.dv[0])]
+
+    def commit(self) -> None:
+        super().commit()
+        if self.fracture is not None:
+            self.fracture.commit()
+
+    def state(self) -> dict[str, np.ndarray]:
+        return super().state() | ({} if self.fracture is None else self.fracture.state())
+
+    def restore(self, arrays) -> None:
+        super().restore(arrays)
+        if self.fracture is not None:
+            self.fracture.restore(arrays)
 
     def _damage(self, eps: np.ndarray) -> dm.DamageUpdate:
         """The trial damage of ``eps`` with the tracking admissions (``DamageHistory.trial_damage``)."""

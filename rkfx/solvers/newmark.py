@@ -454,14 +454,18 @@ def trapezoidal(**options) -> Newmark:
     return Newmark(beta=0.25, gamma=0.5, theta=0.5, **options)
 
 
+GAMMA_MAX = 2.0**0.5 - 0.5  # beta = (gamma + 1/2)^2 / 4 reaches 1/2
+
+
 def damped(gamma: float = 0.6, theta: float = 0.6, **options) -> Newmark:
     """The Newmark family with numerical damping: gamma > 1/2 with beta = (gamma + 1/2)^2 / 4 for
     second-order fields (the high frequencies damped, unconditionally stable), theta > 1/2 for
     first-order ones; first order in time. For loadings that are quasi-static on the elastic
     time scale, taken with steps far above the stiff periods: the trapezoidal rule keeps those
     modes' oscillation undamped from step to step, this does not."""
-    if not 0.5 < gamma <= 1.0:
-        raise InputError(f"gamma = {gamma!r} must lie in (1/2, 1] (0.6: mild damping); 1/2 is the trapezoidal rule")
+    if not 0.5 < gamma <= GAMMA_MAX:
+        raise InputError(f"gamma = {gamma!r} must lie in (1/2, {GAMMA_MAX:.3f}] (0.6: mild damping; above, beta "
+                         "exceeds 1/2); 1/2 is the trapezoidal rule")
     if not 0.5 < theta <= 1.0:
         raise InputError(f"theta = {theta!r} must lie in (1/2, 1] (0.6: mild damping); 1/2 is Crank-Nicolson")
     return Newmark(beta=(gamma + 0.5) ** 2 / 4.0, gamma=gamma, theta=theta, **options)
