@@ -294,3 +294,23 @@ def test_newton_from_the_last_step_finds_the_same_solution_in_fewer_iterations()
     assert out["previous"][1] < out["predictor"][1], out
     with pytest.raises(InputError, match="guess"):
         nm.Newmark(guess="zero")
+
+
+class Loaded(Oscillator):
+    """m x'' + k x + k3 x^3 = 1: a weakly nonlinear spring under a load applied at once."""
+
+    def __init__(self):
+        super().__init__(m=1e-6, k=1.0, k3=1e-7)
+        self.linear = False
+
+    def residual(self, x, t):
+        return super().residual(x, t) - 1.0
+
+
+def test_newton_converges_relative_to_the_predictor_residual():
+    """||F|| <= rtol ||F_0||, F_0 at the predictor: the first update leaves k3 x^3 ~ 1e-7 of the
+    load, within rtol = 1e-6 of the start, so one iteration is enough."""
+    st = nm.trapezoidal(rtol=1e-6)
+    res = integrate(st, Loaded(), [0.0, 1.0], start=st.start(Loaded(), x0=[0.0], a0=[0.0]))
+    assert res.newton_iterations == 1
+    assert abs(res.state.x[0] - 1.0) < 1e-5  # static up to the tiny mass's response

@@ -372,11 +372,11 @@ class _NewmarkSystem:
 
     def converged(self, z, r, iteration):
         st = self.stepper
+        eq, con = r[:self.n], r[self.n:] if self.cw is None else r[self.n:] / self.cw
+        if self.r0 is None:  # the start: the predictor's residual
+            self.r0 = self.norm(eq)
         if iteration < st.min_iterations:
             return False
-        eq, con = r[:self.n], r[self.n:] if self.cw is None else r[self.n:] / self.cw
-        if self.r0 is None:
-            self.r0 = self.norm(eq)
         # Relative to the start and to the size of the terms at this iterate, so that
         # round-off in large cancelling forces does not stall a converged solve.
         ok_eq = self.norm(eq) <= st.atol + st.rtol * max(self.r0, self.scale)
