@@ -265,6 +265,8 @@ class FemHydraulicFractureModel(DamageHistory):
             (``rkfx.fracture.tracking``, spacing sqrt(2 A_e), the grid spacing of the
             structured mesh), seeded by the pre-cracked elements, as the RKPM model tracks its
             particles; ``None``: every element may damage (see the module docstring).
+        damage_update: ``"implicit"`` or ``"impl-ex"`` (``rkfx.fracture.history``), as the
+            RKPM model.
 
     Attributes:
         committed: The committed ``rkfx.fracture.damage.DamageState`` of the elements (element
@@ -281,7 +283,8 @@ class FemHydraulicFractureModel(DamageHistory):
     def __init__(self, mesh: dolfinx.mesh.Mesh, rock: FracturingRock, conditions: Sequence[Condition], *,
                  precracked: Region | None = None, precrack_normal: Sequence[float] = (0.0, 1.0),
                  element: str = "p1p1-fpp", mass: str = "lumped", jacobian: str = "full",
-                 residual: float = RESIDUAL_STIFFNESS, track: tuple[float, float] | None = None):
+                 residual: float = RESIDUAL_STIFFNESS, track: tuple[float, float] | None = None,
+                 damage_update: str = "implicit"):
         if not isinstance(rock, FracturingRock):
             raise InputError(f"rock = {rock!r}: give a rkfx.models.hydraulic_fracture.FracturingRock")
         if element not in ELEMENTS:
@@ -293,6 +296,7 @@ class FemHydraulicFractureModel(DamageHistory):
                              "use mass='consistent' with element='taylor-hood'")
         if jacobian not in JACOBIANS:
             raise InputError(f"jacobian = {jacobian!r}; choose one of {', '.join(JACOBIANS)}")
+        self.use_damage_update(damage_update)
         if not 0.0 < residual < 1.0:
             raise InputError(f"residual = {residual!r}: the least stiffness fraction 1 - D must lie in (0, 1)")
         if mesh.geometry.dim != 2 or mesh.topology.cell_type != dolfinx.mesh.CellType.triangle:
@@ -528,9 +532,10 @@ class FemHydraulicFractureModel(DamageHistory):
         return np.r_[self._ku @ u - self._kc @ P, self._kh @ P]
 
     def _damage(self, eps: np.ndarray) -> dm.DamageUpdate:
-        """The trial damage of the elements' strains ``eps`` from the committed state, with the
-        tracking admissions of the RKPM model (``rkfx.fracture.history.DamageHistory``)."""
-        return self.trial_damage(eps, tangent=False)
+        """The damage of the elements' strains ``eps``: the trial from the committed state with
+        the tracking admissions of the RKPM model, or the step's impl-ex extrapolation
+        (``rkfx.fracture.history.DamageHistory.step_damage``)."""
+        return self.step_damage(eps, tangent=False)
 
     def _loading(self) -> tuple[np.ndarray, np.ndarray]:
         """Elements softening in the trial (kappa grew, 1 - D above the residual) and their
@@ -754,7 +759,7 @@ def solve_hydraulic_fracture(h: float, rock: FracturingRock, rate: float = 5.5e4
                              L: float = 1.0, c: float = 0.1, notch_width: float = 1.5,
                              element: str = "p1p1-fpp", mass: str = "lumped", jacobian: str = "full",
                              residual: float = RESIDUAL_STIFFNESS, track: tuple[float, float] | None = None,
-                             output_times: Sequence[float] = (),
+                             damage_update: str = "implicit", output_times: Sequence[float] = (),
                              sample_points: np.ndarray | None = None, line_search: bool = True,
                              max_cuts: int = 12, comm: MPI.Comm | None = None, checkpoint_every: int = 0,
                              checkpoint_dir: str | Path | None = None, resume: str | Path | None = None,
@@ -776,7 +781,7 @@ def solve_hydraulic_fracture(h: float, rock: FracturingRock, rate: float = 5.5e4
         L, c: Plate side and notch half-length [m].
         notch_width: Half-width of the pressurized vertices about the notch line [spacings]
             (the RKPM case's 1.5 support radii).
-        element, mass, jacobian, residual, track: As ``FemHydraulicFractureModel`` (``track``:
+        element, mass, jacobian, residual, track, damage_update: As ``FemHydraulicFractureModel`` (``track``:
             ``None``, the default, lets every element damage; ``(0.3, 3.5)`` is the RKPM case's).
         output_times: Step times at which p, D and w / w_c are kept.
         sample_points: Where p is sampled at the output times, shape ``(s, 2)`` [m] (default a
@@ -821,7 +826,8 @@ def solve_hydraulic_fracture(h: float, rock: FracturingRock, rate: float = 5.5e4
     conditions = [Displacement(s) for s in sides] + [Pressure(s) for s in sides] + [
         Pressure(notch, lambda x, t: np.full(len(x), rate * t))]
     model = FemHydraulicFractureModel(mesh, rock, conditions, precracked=notch, element=element, mass=mass,
-                                      jacobian=jacobian, residual=residual, track=track)
+                                      jacobian=jacobian, residual=residual, track=track,
+                                      damage_update=damage_update)
     if sample_points is None:
         g = np.linspace(-L / 2, L / 2, 21)
         sample_points = np.column_stack([np.repeat(g, 21), np.tile(g, 21)])

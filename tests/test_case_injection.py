@@ -101,7 +101,8 @@ def test_resume_continues_to_the_same_result(tmp_path):
 
 @pytest.mark.parametrize("args, word", [(["--method", "fem", "--set", "fem_h=0.03"], "divide"),
                                         (["--set", "h=0.03"], "divide"),
-                                        (["--set", "jacobian=exact"], "jacobian")])
+                                        (["--set", "jacobian=exact"], "jacobian"),
+                                        (["--set", "damage_update=explicit"], "damage_update")])
 def test_bad_input_is_refused_in_one_line(args, word, tmp_path):
     out = subprocess.run([sys.executable, "-m", "rkfx.cases.injection", "--quick", *args, "--out", str(tmp_path)],
                          capture_output=True, text=True, timeout=120)

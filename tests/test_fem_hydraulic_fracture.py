@@ -242,12 +242,14 @@ def test_a_failed_step_leaves_the_committed_damage_alone():
     assert model.committed is model.trial.state and len(model.iterations) == 1
 
 
-def test_resumed_run_equals_an_uninterrupted_one(tmp_path):
-    """Checkpoints hold the committed damage: stopped after step 6 of 10 and resumed, the run ends
-    as the uninterrupted one (h = 0.05 m, into the damaging range: damage from 500 s on)."""
+@pytest.mark.parametrize("update", ["implicit", "impl-ex"])
+def test_resumed_run_equals_an_uninterrupted_one(tmp_path, update):
+    """Checkpoints hold the committed damage (and impl-ex's last two steps): stopped after step 6
+    of 10 and resumed, the run ends as the uninterrupted one (h = 0.05 m, into the damaging
+    range: damage from 500 s on)."""
     times = np.arange(0.0, 1001.0, 100.0)
     kw = dict(times=times, output_times=[1000.0], stepper=damped(newton=NewtonOptions(line_search=True)),
-              comm=MPI.COMM_SELF)
+              comm=MPI.COMM_SELF, damage_update=update)
     whole = hf.solve_hydraulic_fracture(0.05, ROCK, **kw)
     assert np.any(whole.damage[-1][~whole.precracked] > 0)
     part = hf.solve_hydraulic_fracture(0.05, ROCK, **(kw | {"times": times[:7], "output_times": []}),

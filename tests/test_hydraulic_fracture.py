@@ -5,6 +5,7 @@ import pytest
 from rkfx.approximation.shape_functions import rk_approximation
 from rkfx.conditions import Displacement, Pressure, Region
 from rkfx.errors import InputError
+from rkfx.fracture import damage as dm
 from rkfx.fracture.tracking import tracking
 from rkfx.geometry.grid_cells import grid_domains
 from rkfx.geometry.particles import graded
@@ -18,7 +19,7 @@ SIDES = ("left", "right", "bottom", "top")
 ROCK = FracturingRock(2.1e11, 0.3, 3000.0, 1000.0, 0.2, 1e-8, 1e4, 2e9, 1e11, 2.7e3, 2.1e7, alpha=1.0)
 
 
-def _plate(n, c=0.1, rate=5.5e4, track=False):
+def _plate(n, c=0.1, rate=5.5e4, track=False, damage_update="implicit"):
     h = 1.0 / n
     xs = -0.5 + h * np.arange(n + 1)
     xs[n // 2] = 0.0
@@ -29,7 +30,8 @@ def _plate(n, c=0.1, rate=5.5e4, track=False):
     model = HydraulicFractureModel(
         p, rk, d, ROCK, displacements=[Displacement(s) for s in SIDES], precracked=np.flatnonzero(notch(p.x)),
         pressures=[Pressure(Region(notch, "notch"), lambda x, t: rate * t * np.ones(len(x)))]
-        + [Pressure(s) for s in SIDES], track=tracking(p.x, p.spacing, 0.3) if track else None)
+        + [Pressure(s) for s in SIDES], track=tracking(p.x, p.spacing, 0.3) if track else None,
+        damage_update=damage_update)
     return p, model, notch, h
 
 
@@ -95,9 +97,9 @@ def test_jacobian_matches_finite_differences_while_damaging(jacobian):
         assert k[2 * n:, :2 * n].nnz == 0 and np.linalg.norm(fd[2 * n:]) > 0
 
 
-@pytest.mark.parametrize("track", [False, True])
-def test_notch_pressure_grows_a_symmetric_crack_along_the_notch(track):
-    p, m, notch, h = _plate(20, track=track)
+@pytest.mark.parametrize("track, update", [(False, "implicit"), (True, "implicit"), (True, "impl-ex")])
+def test_notch_pressure_grows_a_symmetric_crack_along_the_notch(track, update):
+    p, m, notch, h = _plate(20, track=track, damage_update=update)
     times = np.linspace(0.0, 1200.0, 13)
     onset = []
 
@@ -129,6 +131,53 @@ def test_notch_pressure_grows_a_symmetric_crack_along_the_notch(track):
     arrays = m.state()
     m.restore(arrays)
     np.testing.assert_array_equal(m.committed.damage, st.damage)
+
+
+def test_implex_steps_are_smooth_and_extrapolate_the_last_two():
+    """Impl-ex (rkfx.fracture.history): within a step the damage is the extrapolation of the two
+    committed steps before it, whatever the iterate, so the residual is smooth and the full
+    Jacobian its derivative; the committed state is the implicit update, and a checkpoint
+    carries the extrapolation's history."""
+    p, m, notch, h = _plate(12, damage_update="impl-ex")
+    n = p.num_nodes
+    r2 = (p.x**2).sum(axis=1)
+    u = np.zeros((n, 2))
+    u[:, 1] = 6.0 * ROCK.ft / ROCK.E * p.x[:, 1] * np.exp(-r2 / 0.1)
+    P = 1e7 * np.exp(-r2 / 0.02)
+    for k, (scale, dt) in enumerate(((0.9, 10.0), (1.0, 10.0))):  # two committed steps, damage growing
+        m.start_step(k * dt, dt)
+        m.residual(np.r_[scale * u.ravel(), P], 0.0)
+        m.commit()
+    kappa_n, kappa_before = m.committed.kappa.copy(), m._kappa_before.copy()
+    grown = m.committed.damaged & (kappa_n > np.maximum(kappa_before, m.points.kappa0))
+    assert grown.sum() > 20
+    m.start_step(20.0, 5.0)  # half the last step: half its growth
+    x = np.r_[1.05 * u.ravel(), P]
+    m.residual(x, 0.0)
+    d = m.trial.state.damage
+    k_expected = kappa_n + 0.5 * (kappa_n - np.maximum(kappa_before, m.points.kappa0))
+    np.testing.assert_allclose(d[grown], dm.damage(k_expected, m.points.kappa0, m.committed.kappa_c)[grown])
+    assert np.all(d >= m.committed.damage) and (d[grown] > m.committed.damage[grown]).all()
+    # the same damage at another iterate; the Jacobian is the residual's derivative
+    k = m.tangent(x, 0.0)
+    rng = np.random.default_rng(3)
+    v = np.r_[rng.standard_normal(2 * n), np.zeros(n)] * 1e-9
+    fd = (m.residual(x + v, 0.0) - m.residual(x - v, 0.0)) / 2
+    np.testing.assert_array_equal(m.trial.state.damage, d)
+    assert np.linalg.norm(fd - k @ v) < 1e-6 * np.linalg.norm(k @ v)
+    # committing takes the implicit update of the last strains; the checkpoint keeps the history
+    m.residual(x, 0.0)
+    implicit = m.trial_damage(m.strain, tangent_floor=m.residual_fraction).state
+    m.commit()
+    np.testing.assert_array_equal(m.committed.kappa, implicit.kappa)
+    saved = m.state()
+    np.testing.assert_array_equal(saved["implex_kappa_before"], kappa_n)
+    m._kappa_before = None
+    m.restore(saved)
+    np.testing.assert_array_equal(m._kappa_before, kappa_n)
+    assert m._dt_before == 5.0
+    with pytest.raises(InputError, match="damage_update"):
+        _plate(6, damage_update="explicit")
 
 
 def test_bad_rock_is_refused_in_one_line():

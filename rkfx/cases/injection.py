@@ -24,7 +24,11 @@ and the notch pressure prescribed on them (a ``Region`` condition). Crack growth
 strain, linear softening regularized by the cell chord (4.28), particle tracking (4.22) with
 ``tol`` within ``radius`` h seeded by the notch particles. The trapezoidal rule (5.18)-(5.24) with
 steps of ``dt`` and Newton with the ``jacobian`` (``full`` with dK_H/dU, or the symmetrized
-(5.36)); a step whose Newton fails is cut in halves.
+(5.36)); a step whose Newton fails is cut in halves. ``damage_update``: ``implicit`` (the
+seed's: the damage of every Newton iterate) or ``impl-ex`` (the damage of a step extrapolated
+from the two before it, the implicit update committed at its end: ``rkfx.fracture.history``),
+which keeps Newton away from softening and loading/unloading switches at a first-order error in
+dt.
 
 Reported per run: the crack's tips and length against time (the outermost cracked cells,
 w / w_c >= 0.5), the onset of propagation (the first step with a cracked particle outside the
@@ -54,7 +58,7 @@ always have (at h = 0.025 m both starts take the same 93 iterations).
 
 Parameters (``--set NAME=VALUE``, SI units): E, nu, rho_s, rho_w, porosity, k_h, gamma_w, K_w,
 K_s, GF, ft, viscosity, alpha, L, c, rate, t_end, dt, t_out, h, fem_h, tol, radius, jacobian,
-support_factor. Long runs: ``--checkpoint-every N`` and ``--resume DIR``.
+damage_update, support_factor. Long runs: ``--checkpoint-every N`` and ``--resume DIR``.
 
     python -m rkfx.cases.injection [--quick] [--method rkpm|both] [--set NAME=VALUE] [--out DIR] [--vtk]
 
@@ -79,6 +83,7 @@ from rkfx.conditions import Displacement, Pressure, Region
 from rkfx.errors import InputError, SolverError
 from rkfx.fracture import damage as dm
 from rkfx.fracture.tracking import check_tracking, tracking
+from rkfx.fracture.history import DAMAGE_UPDATES
 from rkfx.geometry.grid_cells import grid_domains
 from rkfx.geometry.particles import graded
 from rkfx.models.hydraulic_fracture import JACOBIANS, FracturingRock, HydraulicFractureModel
@@ -124,6 +129,7 @@ PARAMS = {
     "tol": Param(0.3, "tracking tolerance of (4.22) [-]"),
     "radius": Param(3.5, "tracking radius [spacings]"),
     "jacobian": Param("full", "Newton's Jacobian: full (with dK_H/dU) or symmetric (5.36)"),
+    "damage_update": Param("implicit", "implicit (every Newton iterate) or impl-ex (extrapolated over a step)"),
     "support_factor": Param(1.5, "RK support radius / spacing [-]"),
     "max_cuts": Param(12, "halvings of a step whose Newton fails before the run stops [-]"),
 }
@@ -135,6 +141,7 @@ def _intervals(length: float, h: float) -> int:
 
 
 def check(*, L, c, h, dt, t_end, t_out, tol, radius, jacobian, support_factor, rate, max_cuts=12,
+          damage_update="implicit",
           methods=("rkpm",), fem_h=(), **material) -> None:
     """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
     spacings = [("h", hh) for hh in h] + ([("fem_h", hh) for hh in fem_h] if "fem" in methods else [])
@@ -157,6 +164,8 @@ def check(*, L, c, h, dt, t_end, t_out, tol, radius, jacobian, support_factor, r
         raise InputError(f"max_cuts = {max_cuts!r} must be a whole number >= 0")
     if jacobian not in JACOBIANS:
         raise InputError(f"jacobian = {jacobian!r}; choose one of {', '.join(JACOBIANS)}")
+    if damage_update not in DAMAGE_UPDATES:
+        raise InputError(f"damage_update = {damage_update!r}; choose one of {', '.join(DAMAGE_UPDATES)}")
     check_tracking(tol, radius)
     _preflight.support_factor_ok(support_factor)
 
@@ -257,6 +266,7 @@ class _Record:
 
 
 def solve(h: float, *, L, c, rate, t_end, dt, t_out, tol, radius, jacobian, support_factor, rock, max_cuts=12,
+          damage_update="implicit",
           io=None, comm=None, vtk=None) -> dict:
     """One refinement: the crack history, maps and Darcy velocity (see the module docstring); with
     ``vtk`` a folder, the particle fields at the times ``t_out`` are written there."""
@@ -277,6 +287,7 @@ def solve(h: float, *, L, c, rate, t_end, dt, t_out, tol, radius, jacobian, supp
         p, rk, domains, rock, displacements=[Displacement(s) for s in SIDES],
         pressures=[Pressure(Region(in_notch, "notch"), lambda x, t: np.full(len(x), rate * t))]
         + [Pressure(s) for s in SIDES], precracked=np.flatnonzero(notch), jacobian=jacobian,
+        damage_update=damage_update,
         track=tracking(p.x, p.spacing, tol, seeds=notch, radius=radius))
     g = np.linspace(-L / 2, L / 2, SAMPLES)
     samples = np.column_stack([np.repeat(g, SAMPLES), np.tile(g, SAMPLES)])  # x slow, y fast
@@ -319,13 +330,14 @@ def run(*, methods: Sequence[str] = ("rkpm",), E=2.1e11, nu=0.3, rho_s=3000.0, r
         k_h=1e-8, gamma_w=1e4, K_w=2e9, K_s=1e11, GF=2.7e3, ft=2.1e7, viscosity=1e-3, alpha=1.0, L=1.0, c=0.1,
         rate=5.5e4, t_end=4000.0, dt=50.0, t_out=(1000.0, 2000.0, 3000.0, 4000.0), h=(5e-3, 2.5e-3),
         fem_h=(5e-3, 2.5e-3), tol=0.3,
-        radius=3.5, jacobian="full", support_factor=1.5, max_cuts=12, checkpoint_every=0, work_dir=None, resume=None,
+        radius=3.5, jacobian="full", damage_update="implicit", support_factor=1.5, max_cuts=12, checkpoint_every=0,
+        work_dir=None, resume=None,
         vtk=None) -> Results:
     """Every refinement; see the module docstring. ``vtk``: a folder for the ParaView files (``--vtk``)."""
     material = dict(E=E, nu=nu, rho_s=rho_s, rho_w=rho_w, porosity=porosity, k_h=k_h, gamma_w=gamma_w, K_w=K_w,
                     K_s=K_s, GF=GF, ft=ft, viscosity=viscosity, alpha=alpha)
     setup = dict(L=L, c=c, rate=rate, t_end=t_end, dt=dt, t_out=list(t_out), tol=tol, radius=radius,
-                 jacobian=jacobian, support_factor=support_factor, max_cuts=max_cuts)
+                 jacobian=jacobian, damage_update=damage_update, support_factor=support_factor, max_cuts=max_cuts)
     check(h=list(h), methods=tuple(methods), fem_h=list(fem_h), **setup, **material)
     rock = _rock(**material)
     est = onset_estimates(rock, c, rate)
@@ -389,7 +401,8 @@ def _compare_refinements(runs: list[Run]) -> None:
         fine.errors["length_vs_coarser"] = fine.info["length_end"] / coarse.info["length_end"] - 1.0
 
 
-def solve_fem(h: float, *, L, c, rate, t_end, dt, t_out, jacobian, rock, max_cuts=12, io=None, comm=None,
+def solve_fem(h: float, *, L, c, rate, t_end, dt, t_out, jacobian, rock, max_cuts=12, damage_update="implicit",
+              io=None, comm=None,
               **_) -> Run:
     """One crack-band FEM refinement (``fem_baselines.hydraulic_fracture``) on the particles of
     spacing ``h`` as mesh vertices, reported as the RKPM runs are."""
@@ -401,7 +414,8 @@ def solve_fem(h: float, *, L, c, rate, t_end, dt, t_out, jacobian, rock, max_cut
     times = np.unique(np.r_[np.arange(0.0, t_end, dt), t_end, np.asarray(t_out, float)])
     g = np.linspace(-L / 2, L / 2, SAMPLES)
     samples = np.column_stack([np.repeat(g, SAMPLES), np.tile(g, SAMPLES)])  # x slow, y fast, as RKPM's
-    res = solve_hydraulic_fracture(h, rock, rate, times, L=L, c=c, jacobian=jacobian, output_times=t_out,
+    res = solve_hydraulic_fracture(h, rock, rate, times, L=L, c=c, jacobian=jacobian, damage_update=damage_update,
+                                   output_times=t_out,
                                    sample_points=samples, max_cuts=max_cuts, comm=comm,
                                    progress=lambda it: _cli.progress(it, label, len(times) - 1), **(io or {}))
     if res.stopped is not None and (comm is None or comm.rank == 0):

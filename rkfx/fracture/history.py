@@ -9,12 +9,30 @@ baseline share it. The model holds ``committed`` (a ``DamageState``), ``points``
 ``DamageModel``), ``allowed`` (or ``None`` without tracking), ``parent``, ``iterations`` (Newton
 iterations of every accepted step), ``_count`` (those of the step under way) and ``track`` (a
 ``rkfx.fracture.tracking.Tracking``, or ``None``).
+
+Damage updates (``damage_update``, set by the model):
+
+* ``"implicit"``: every residual evaluates the damage of its strains from the committed state
+  (the seed's Newton on (5.34)-(5.36)); a softening particle's tangent turns negative and its
+  loading/unloading switches between iterates.
+* ``"impl-ex"``: the damage of a step is extrapolated from the two committed steps before it
+  (Oliver, Huespe and Cante 2008, "An implicit/explicit integration scheme to increase
+  computability of non-linear material and contact/friction problems", CMAME 197):
+  kappa~ = kappa_n + (dt / dt_n) (kappa_n - max(kappa_(n-1), kappa0)) at the damaged points,
+  D~ = D(kappa~), fixed over the step's iterates, so the step's solid response is the secant
+  (1 - D~) C and Newton meets no softening or switching; once the step is accepted the
+  implicit update of its converged strains is committed (and next extrapolated from). The
+  error is first order in dt; the model's step size (``start_step``, called by the stepper)
+  enters the extrapolation.
 """
-from dataclasses import fields
+from dataclasses import fields, replace
 
 import numpy as np
 
+from rkfx.errors import InputError
 from rkfx.fracture import damage as dm
+
+DAMAGE_UPDATES = ("implicit", "impl-ex")
 
 
 class DamageHistory:
@@ -22,6 +40,54 @@ class DamageHistory:
     admission of tracking candidates (see the module docstring)."""
 
     MAX_TRACKING_ROUNDS = 1000  # admissions within one residual (each admits at least one point)
+    damage_update = "implicit"
+    _dt = None                 # the step under way (start_step)
+    _kappa_before = None       # impl-ex: kappa of the committed step before the last, and
+    _dt_before = None          # the last committed step's size
+    _last_strain = None        # impl-ex: the strains and options of the last residual
+    _extrapolated = None       # impl-ex: (committed, dt, state) of the step under way
+
+    def use_damage_update(self, name: str) -> None:
+        """Choose ``"implicit"`` or ``"impl-ex"`` (module docstring)."""
+        if name not in DAMAGE_UPDATES:
+            raise InputError(f"damage_update = {name!r}; choose one of {', '.join(DAMAGE_UPDATES)}")
+        self.damage_update = name
+
+    def start_step(self, t: float, dt: float) -> None:
+        """The stepper's next step (from t, of size dt): the impl-ex extrapolation's step."""
+        self._dt = float(dt)
+
+    def step_damage(self, eps: np.ndarray, **options) -> dm.DamageUpdate:
+        """The damage of a residual's strains ``eps``: the implicit trial (``trial_damage``) or
+        the step's impl-ex extrapolation with the secant stress and tangent (module docstring)."""
+        if self.damage_update == "implicit":
+            return self.trial_damage(eps, **options)
+        self._last_strain = (eps, options)
+        st = self._extrapolation()
+        c = self.points.material.elasticity()
+        frac = 1.0 - st.damage
+        effective = eps @ c.T
+        tangent = None
+        if options.get("tangent", True):
+            tangent = np.maximum(frac, options.get("tangent_floor", 0.0))[:, None, None] * c
+        return dm.DamageUpdate(st, frac[:, None] * effective, tangent, 0.0)
+
+    def _extrapolation(self) -> dm.DamageState:
+        """The committed state with the impl-ex damage D~ of the step under way (its kappa stays
+        the committed one: no point counts as loading within the step)."""
+        c, dt = self.committed, self._dt
+        if self._extrapolated is not None and self._extrapolated[0] is c and self._extrapolated[1] == dt:
+            return self._extrapolated[2]
+        d = c.damage
+        if self._kappa_before is not None and self._dt_before and dt and c.damaged.any():
+            k0 = self.points.kappa0
+            grown = np.maximum(c.kappa - np.maximum(self._kappa_before, k0), 0.0)
+            kappa = np.maximum(c.kappa + (dt / self._dt_before) * grown, k0)
+            d = np.where(c.damaged, dm.damage(kappa, k0, np.where(c.damaged, c.kappa_c, np.inf)), c.damage)
+            d = np.maximum(d, c.damage)
+        st = replace(c, damage=d)
+        self._extrapolated = (c, dt, st)
+        return st
 
     def trial_damage(self, eps: np.ndarray, **options) -> dm.DamageUpdate:
         """The trial damage of the strains ``eps`` from the committed state
@@ -57,7 +123,13 @@ class DamageHistory:
         return bool(fresh.any())
 
     def commit(self) -> None:
-        """The last residual's trial damage (and the step's admissions) become the committed ones."""
+        """The last residual's trial damage (and the step's admissions) become the committed ones;
+        under impl-ex, the implicit update of the step's converged strains."""
+        if self.damage_update == "impl-ex" and self._last_strain is not None:
+            eps, options = self._last_strain
+            self.trial = self.trial_damage(eps, **options)
+            self._kappa_before, self._dt_before = self.committed.kappa, self._dt
+            self._last_strain = None
         self.committed = self.trial.state
         if self._trial_tracking is not None:
             self.allowed, self.parent = self._trial_tracking
@@ -72,6 +144,9 @@ class DamageHistory:
             "iterations": np.array(self.iterations, np.int64), "parent": self.parent}
         if self.allowed is not None:
             out["allowed"] = self.allowed
+        if self.damage_update == "impl-ex" and self._kappa_before is not None:
+            out["implex_kappa_before"] = self._kappa_before
+            out["implex_dt_before"] = np.array([self._dt_before])
         return out
 
     def restore(self, arrays) -> None:
@@ -83,3 +158,7 @@ class DamageHistory:
             self.allowed = np.array(arrays["allowed"], bool)
         self._trial_tracking = None
         self._count = 0
+        if "implex_kappa_before" in arrays:
+            self._kappa_before = np.array(arrays["implex_kappa_before"])
+            self._dt_before = float(np.asarray(arrays["implex_dt_before"])[0])
+        self._extrapolated = self._last_strain = None

@@ -191,6 +191,9 @@ class HydraulicFractureModel(DamageHistory):
         contact: The frictional contact law of a pre-existing fracture whose faces are the
             boundary part ``fracture`` (``cut_triangulation``'s name; the approximation ``rk``
             must carry its cracks); ``None``: no such fracture.
+        damage_update: ``"implicit"`` (the seed's: the damage of every Newton iterate) or
+            ``"impl-ex"`` (the damage of a step extrapolated from the two before it, the
+            implicit update committed at its end; ``rkfx.fracture.history``).
         track: Particle tracking (``rkfx.fracture.tracking``): only its seeds, the damaged
             particles and the candidates (4.22) of the damaged ones may damage. Within every
             residual the particles that initiate admit their candidates at once and the
@@ -212,10 +215,12 @@ class HydraulicFractureModel(DamageHistory):
                  residual: float = RESIDUAL_STIFFNESS, eps_p: float = 1.0,
                  jacobian: str = "symmetric", track: Tracking | None = None,
                  injection: tuple[Region, Callable[[float], float]] | None = None,
-                 contact: FrictionalContact | None = None, fracture: str = "crack"):
+                 contact: FrictionalContact | None = None, fracture: str = "crack",
+                 damage_update: str = "implicit"):
         if jacobian not in JACOBIANS:
             raise InputError(f"jacobian = {jacobian!r}; choose one of {', '.join(JACOBIANS)}")
         self.jacobian = jacobian
+        self.use_damage_update(damage_update)
         if not 0.0 < residual < 1.0:
             raise InputError(f"residual = {residual!r} must lie in (0, 1)")
         if not (displacements or pressures):
@@ -444,8 +449,9 @@ class HydraulicFractureModel(DamageHistory):
             self.fracture.restore(arrays)
 
     def _damage(self, eps: np.ndarray) -> dm.DamageUpdate:
-        """The trial damage of ``eps`` with the tracking admissions (``DamageHistory.trial_damage``)."""
-        return self.trial_damage(eps, tangent_floor=self.residual_fraction)
+        """The damage of ``eps``: the trial with the tracking admissions, or the step's impl-ex
+        extrapolation (``DamageHistory.step_damage``)."""
+        return self.step_damage(eps, tangent_floor=self.residual_fraction)
 
 
 def _unit(normal: np.ndarray) -> np.ndarray:

@@ -15,7 +15,9 @@ iteration or a cut step never touches committed state, and checkpoints save ``st
 
 A capacity that depends on the state (unsaturated storage) is the optional term c(x, v)
 of ``rate_force(x, v)``, with ``rate_tangents()`` = (dc/dx, dc/dv) at its last point, added
-to C x' (``rkfx.solvers.newmark``).
+to C x' (``rkfx.solvers.newmark``). A model whose history update depends on the step (the
+impl-ex damage of ``rkfx.fracture.history``) has ``start_step(t, dt)``, which the Newmark
+stepper calls before each step it tries.
 
 The steppers only call the methods below; ``rkfx.solvers.newmark`` and
 ``rkfx.solvers.quasi_static`` document which they need.

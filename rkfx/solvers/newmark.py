@@ -216,6 +216,9 @@ class Newmark:
             raise InputError(f"time step dt = {dt!r} must be positive")
         orders = model.layout.orders
         t1 = s.t + dt
+        start = getattr(model, "start_step", None)
+        if start is not None:  # optional: a model whose update depends on the step (rkfx.solvers.model)
+            start(s.t, dt)
         x_t, v_t = self.predict(orders, s, dt)
         con = model.constraints(t1)
         key = ("newmark-plan", id(model))
