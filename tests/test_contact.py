@@ -35,6 +35,22 @@ def test_law_states_and_return_mapping():
     np.testing.assert_allclose(again.shear, [0.7, -0.7])
 
 
+def test_touching_faces_stick_and_a_point_at_the_limit_slides():
+    # zero aperture is contact: the penalties act (Newton from an unloaded fracture has them)
+    r = respond(LAW, np.zeros(1), np.zeros(1), np.zeros(1))
+    assert r.status[0] == STICK and r.d_pressure[0] == -LAW.k_N and r.d_shear_slip[0] == LAW.k_T
+    # a slip returned to the limit is still sliding at the committed state, whatever the round-off
+    g_n, g_t = np.array([-1e-3, -1e-3]), np.array([5e-3, -5e-3])
+    slipped = respond(LAW, g_n, g_t, np.zeros(2)).slip
+    for wobble in (0.0, 1e-15, -1e-15):
+        again = respond(LAW, g_n, g_t + wobble, slipped)
+        np.testing.assert_array_equal(again.status, [SLIP, SLIP])
+        np.testing.assert_allclose(again.shear, [0.7, -0.7])
+    # unloading from there sticks
+    back = respond(LAW, g_n, g_t - np.sign(g_t) * 1e-4, slipped)
+    np.testing.assert_array_equal(back.status, [STICK, STICK])
+
+
 @pytest.mark.parametrize("g_t", [1e-4, 4e-3, -4e-3])
 def test_law_derivatives_match_differences(g_t):
     g_n, s, d = np.array([-1e-3]), np.array([2e-4]), 1e-9

@@ -307,3 +307,20 @@ def test_failure_displacement_of_a_linear_softening_curve():
     # A sudden break (the force still rising before it vanishes): the first zero.
     assert dm.failure_displacement([0.0, 1.0, 2.0, 2.1], [0.0, 1.0, 2.0, 0.0]) == 2.1
     assert np.isnan(dm.failure_displacement([0.0, 1.0], [0.0, 1.0]))
+
+
+def test_a_point_without_chord_takes_its_cell_size():
+    """A corner cell's line along the crack can leave the domain at once on both sides (chord 0);
+    kappa_c (4.28) then takes A_L = sqrt(V_L), the cell's size, instead of refusing the cell."""
+    p = structured(1.0, 1.0, 5, 5)
+    d = nodal_domains(p)
+    model = dm.damage_model(MAT, d.area, geometry=dm.cell_geometry(p))
+    corner = int(np.argmin(np.linalg.norm(p.x, axis=1)))
+    n = np.array([[1.0, 1.0]]) / np.sqrt(2.0)
+    assert dm.chord_lengths(model.geometry, [corner], n)[0] == 0.0
+    m = model.num_points
+    normal, chord, kappa_c = np.zeros((m, 2)), np.full(m, np.nan), np.full(m, np.nan)
+    dm.initiate(model, np.array([corner]), np.array([[1.0, 1.0, 1.0]]), normal, chord, kappa_c)
+    assert np.allclose(np.abs(normal[corner]), n[0])
+    assert np.isclose(chord[corner], np.sqrt(d.area[corner]))
+    assert kappa_c[corner] > model.kappa0[corner]

@@ -314,3 +314,25 @@ def test_newton_converges_relative_to_the_predictor_residual():
     res = integrate(st, Loaded(), [0.0, 1.0], start=st.start(Loaded(), x0=[0.0], a0=[0.0]))
     assert res.newton_iterations == 1
     assert abs(res.state.x[0] - 1.0) < 1e-5  # static up to the tiny mass's response
+
+
+def test_until_ends_the_run_at_its_event_and_a_resume_ends_there_too(tmp_path):
+    model = Oscillator(k3=5.0)
+    st = nm.trapezoidal()
+    times = np.linspace(0, 2.0, 81)
+
+    def crossed(s):  # x = cos(...) first falls below zero
+        return s.x[0] < 0.0
+
+    rec = Final()
+    out = integrate(st, model, times, start=st.start(model, x0=[1.0]), recorder=rec, until=crossed,
+                    checkpoint_every=1000, checkpoint_dir=tmp_path)
+    assert out.ended_early and out.state.x[0] < 0.0 and rec.x[-2] >= 0.0 < out.state.step < len(times) - 1
+    full = Final()
+    integrate(st, model, times, start=st.start(model, x0=[1.0]), recorder=full)
+    assert np.array_equal(np.array(rec.x), np.array(full.x)[:len(rec.x)])
+    # the checkpoint is written at the event, and resuming from it ends there at once
+    again = integrate(st, model, times, recorder=Final(), until=crossed, resume=tmp_path)
+    assert again.ended_early and again.state.step == out.state.step and again.substeps == 0
+    # without the test, the resumed run goes on to the end
+    assert integrate(st, model, times, recorder=Final(), resume=tmp_path).state.step == len(times) - 1

@@ -100,11 +100,13 @@ class ContactResponse:
 def respond(law: FrictionalContact, g_n: np.ndarray, g_t: np.ndarray, slip: np.ndarray) -> ContactResponse:
     """The contact tractions of (5.38)-(5.39) for apertures ``g_n``, slips ``g_t`` and committed
     plastic slips ``slip`` (module docstring), with their derivatives."""
-    closed = g_n < 0.0
+    closed = g_n <= 0.0  # at zero aperture the faces touch: the penalties act (Newton from a closed start)
     pressure = law.k_N * np.where(closed, -g_n, 0.0)
     trial = law.k_T * (g_t - slip)
     limit = law.mu * pressure
-    sliding = closed & (np.abs(trial) > limit)
+    # A point at the friction limit (a committed slip returns it there exactly, up to round-off)
+    # slides: Newton from the last step's state then starts from the tangent of continued slip.
+    sliding = closed & ((np.abs(trial) > limit) | ((limit > 0) & (np.abs(trial) >= limit * (1.0 - 1e-9))))
     sticking = closed & ~sliding
     sign = np.sign(trial)
     shear = np.where(sticking, trial, np.where(sliding, limit * sign, 0.0))

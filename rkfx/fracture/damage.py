@@ -500,7 +500,10 @@ def initiate(model: DamageModel, points: np.ndarray, effective: np.ndarray, norm
     at = points if at is None else at
     normal[at] = principal_direction(effective)
     if model.regularized:
-        chord[at] = chord_lengths(model.geometry, points, normal[at])
+        c = chord_lengths(model.geometry, points, normal[at])
+        # A point on a cell's boundary whose line across n_L leaves the cell at once (a particle
+        # on a cut face) has no chord; it takes the cell's size sqrt(V_L), as its band width does.
+        chord[at] = np.where(c > 0, c, np.sqrt(model.volume[points]))
         kappa_c[at] = model.band_factor * critical_strain(model.material, chord[at], model.volume[points])
 
 

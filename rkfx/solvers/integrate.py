@@ -7,6 +7,9 @@ failed step never touches the model's history. Every finished grid step is commi
 to ``recorder.record(state)``, and every ``checkpoint_every`` grid steps the stepper state,
 the model's committed history and the recorder's arrays are written atomically to
 ``checkpoint_dir``; ``resume=DIR`` continues from there and ends as an uninterrupted run would.
+``until(state)`` ends the run early, after the first committed grid step for which it holds
+(an event: a crack reaching a boundary); a checkpoint is written there, and resuming from it
+ends at once.
 A model distributed over MPI ranks (``rkfx.parallel.unknowns``) writes one checkpoint per
 rank (``rank<r>-of-<P>/``), which resumes on the same number of ranks.
 """
@@ -51,6 +54,7 @@ class Integration:
         factorizations: Matrices factorized here.
         resumed_from: Grid step of the checkpoint resumed from, or ``None``.
         wall_time_s: Wall time of the loop [s].
+        ended_early: ``until`` held before the last step time.
     """
 
     state: StepState
@@ -61,6 +65,7 @@ class Integration:
     factorizations: int
     resumed_from: int | None
     wall_time_s: float
+    ended_early: bool = False
 
 
 def time_grid(output_times: Sequence[float], first_step: float, growth: float = 1.0,
@@ -97,7 +102,7 @@ def integrate(stepper: Newmark, model: Model, times: Sequence[float], *, start: 
               recorder: Recorder | None = None, solves: Factorizations | None = None, comm=None,
               solver: str = "mumps", max_cuts: int = 4, checkpoint_every: int = 0,
               checkpoint_dir: str | Path | None = None, resume: str | Path | None = None,
-              progress: Callable | None = None) -> Integration:
+              progress: Callable | None = None, until: Callable[[StepState], bool] | None = None) -> Integration:
     """Advance ``model`` through the step times ``times`` with ``stepper``.
 
     Args:
@@ -114,6 +119,8 @@ def integrate(stepper: Newmark, model: Model, times: Sequence[float], *, start: 
         checkpoint_dir: Folder of the checkpoint.
         resume: A checkpoint folder to continue from.
         progress: Optional wrapper of the step iterator (a progress bar).
+        until: Optional test of each committed grid step; the run ends after the first that
+            passes it.
 
     Raises:
         SolverError: A step failed at the smallest cut, naming the step, time, iteration and
@@ -149,7 +156,8 @@ def integrate(stepper: Newmark, model: Model, times: Sequence[float], *, start: 
             raise InputError(f"the start state is at t = {s.t:.6g}, the step times start at {t_all[0]:.6g}")
     substeps = cuts = iterations = 0
     t_wall = _time.perf_counter()
-    steps = range(s.step + 1, len(t_all))
+    ended = resumed is not None and until is not None and s.step < len(t_all) - 1 and bool(until(s))
+    steps = range(s.step + 1, len(t_all) if not ended else s.step + 1)
     try:
         for k in (progress(steps) if progress else steps):
             target = float(t_all[k])
@@ -176,10 +184,13 @@ def integrate(stepper: Newmark, model: Model, times: Sequence[float], *, start: 
                 s = new
             if recorder is not None:
                 recorder.record(s)
-            if checkpoint_every and (k % checkpoint_every == 0 or k == len(t_all) - 1):
+            ended = until is not None and k < len(t_all) - 1 and bool(until(s))
+            if checkpoint_every and (k % checkpoint_every == 0 or k == len(t_all) - 1 or ended):
                 save_run(files.folder(checkpoint_dir), prefixed(s.arrays(), "state__"), model, recorder, files.writer)
+            if ended:
+                break
     finally:
         made = solves.count - made
         if own:
             solves.destroy()
-    return Integration(s, s.step, substeps, cuts, iterations, made, resumed, _time.perf_counter() - t_wall)
+    return Integration(s, s.step, substeps, cuts, iterations, made, resumed, _time.perf_counter() - t_wall, ended)

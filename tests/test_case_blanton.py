@@ -1,0 +1,112 @@
+"""Blanton's tests (seed 5.3.3): the case's set-up, its classification of a stage, its input checks."""
+import subprocess
+import sys
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from rkfx.cases import blanton as case
+from rkfx.errors import InputError
+
+
+def _params(**over):
+    return {k: v.default for k, v in case.PARAMS.items()} | case.QUICK | over
+
+
+@pytest.mark.parametrize("bad, match", [
+    (dict(tests=["CT-5"]), r"CT-5"),
+    (dict(notch=0.045), r"notch = 0.045: the notch must end at least 2 h short"),
+    (dict(offset=0.2), r"offset = 0.2: the pre-fracture must cross"),
+    (dict(dt=0.02), r"dt = 0.02 must not exceed t_ramp"),
+    (dict(h=[0.03]), r"h = 0.03 must be positive and at most half the notch"),
+    (dict(jacobian="exact"), r"jacobian"),
+    (dict(margin=0.2), r"margin = 0.2 must lie in"),
+    (dict(mu=0.0), r"mu = 0.0"),
+])
+def test_bad_input_is_refused_in_one_line(bad, match):
+    with pytest.raises(InputError, match=match) as err:
+        case.check(**_params(**bad))
+    assert "\n" not in str(err.value)
+
+
+def test_the_tests_of_table_5_1():
+    assert [(t.name, t.theta, t.sigma_H / 1e6, t.sigma_h / 1e6, t.pressure / 1e6, t.observed) for t in case.TESTS.values()] \
+        == [("CT-4", 60, 12, 10, 17, "arrest"), ("CT-7", 30, 19, 10, 17, "arrest"), ("CT-8", 60, 20, 5, 15, "cross"),
+            ("CT-9", 30, 20, 5, 15, "arrest")]
+
+
+def test_step_times_apply_the_confinement_drained_and_then_step_the_growth():
+    t = case._step_times(100.0, 200.0, 0.01, 2e-4, 0.04)
+    assert t[0] == 0.0 and t[1] == 10.0 and 100.0 in t and 200.0 in t  # first step >> drainage time (~4 s)
+    assert np.diff(t[t <= 200.0]).max() <= 20.0 + 1e-12
+    grow = t[t > 200.0]
+    np.testing.assert_allclose(np.diff(np.r_[200.0, grow]), 2e-4, rtol=1e-6)
+    assert np.isclose(grow[-1], 200.05)
+
+
+def test_load_histories():
+    pb = case._History([1.0, 2.0], [0.0, 10.0])
+    assert pb(-1.0) == 0.0 and pb(1.5) == 5.0 and pb(7.0) == 10.0
+
+
+def _block(x, h=0.01):
+    """A pre-fracture along the y axis, the borehole on its left (x < 0), the HF's line y = 0."""
+    x = np.asarray(x, float)
+    return SimpleNamespace(x=x, distance=x[:, 0], borehole_side=-1.0, h=h, intersection=np.zeros(2))
+
+
+def test_classification_of_a_test():
+    h = 0.01
+    hf = [(-0.05, 0.0), (-0.035, 0.0), (-0.02, 0.0), (-0.005, 0.0)]     # the HF up to the pre-fracture
+    beyond = [(0.005, 0.0), (0.02, 0.0), (0.035, 0.0), (0.05, 0.0)]    # its continuation on the far side
+    elsewhere = [(0.03, 0.10), (0.045, 0.10), (0.06, 0.10)]            # far-side damage away from the HF
+    b = _block(hf + beyond + elsewhere, h)
+    mask = lambda n_hf, n_beyond, n_else: np.array([i < n_hf for i in range(4)] + [i < n_beyond for i in range(4)]  # noqa: E731
+                                                    + [i < n_else for i in range(3)])
+    assert case.classify(b, mask(4, 0, 0), 0.0) == ("arrest", 0.0)
+    assert case.classify(b, mask(4, 0, 0), 0.05)[0] == "open"           # > 4 h of the pre-fracture opened
+    assert case.classify(b, mask(4, 0, 0), 0.03)[0] == "arrest"
+    assert case.classify(b, mask(4, 2, 0), 0.0) == ("arrest", 0.02)     # 2 h beyond: not yet a crossing
+    mode, depth = case.classify(b, mask(4, 4, 0), 0.05)
+    assert mode == "cross" and np.isclose(depth, 0.05)
+    # cracks beyond the pre-fracture that do not start at the intersection are no crossing
+    assert case.classify(b, mask(4, 0, 3), 0.05) == ("open", 0.0)
+    assert case.classify(b, mask(4, 1, 3), 0.0) == ("arrest", 0.005)
+    assert case.classify(b, mask(1, 0, 0), 0.0)[0] == "not reached"
+    assert case.classify(b, mask(0, 0, 3), 0.0)[0] == "not reached"
+
+
+def test_the_cli_refuses_a_fem_only_run_in_one_line():
+    out = subprocess.run([sys.executable, "-m", "rkfx.cases.blanton", "--method", "fem"], capture_output=True,
+                         text=True, timeout=120)
+    assert out.returncode == 2
+    assert out.stderr.strip().endswith("blanton has no FEM baseline yet: run --method rkpm")
+    assert len(out.stderr.strip().splitlines()) == 1
+
+
+def _run(test):
+    return case.run(methods=("rkpm",), **_params(tests=[test]))
+
+
+def test_ct8_crosses_the_pre_fracture():
+    """CT-8 (60 deg, 20/5 MPa, 15 MPa): the HF runs through the intersection and beyond it
+    (measured at h = 5 mm: through in 13.5 ms, 95 mm beyond, 73 Newton iterations, 46 s)."""
+    res = _run("CT-8")
+    (r,) = res.runs
+    assert r.info["mode"] == "cross" and r.info["crossed"] == 1 == r.info["observed_crossed"]
+    assert r.info["depth_beyond"] > 10 * r.info["h"] and r.series["stopped"] is None
+    assert r.info["ended_by_margin"]  # through to the block's edge before t_grow ran out
+    x, w = np.asarray(r.series["x"]), np.asarray(r.series["opening"])
+    assert np.abs(x[w >= case.CRACKED, 1]).max() < 0.05  # the crack stays along sigma_H
+    assert r.info["rp"] == "cross" and r.info["gw"] == "arrest"
+
+
+@pytest.mark.slow
+def test_ct4_is_arrested_by_the_pre_fracture():
+    """CT-4 (60 deg, 12/10 MPa, 17 MPa): the HF meets the pre-fracture, which slips there, and
+    stops (measured at h = 5 mm: the far wing reaches the block's edge after 113 ms, 148 s)."""
+    (r,) = _run("CT-4").runs
+    assert r.info["mode"] in ("arrest", "open") and r.info["crossed"] == 0 == r.info["observed_crossed"]
+    assert r.info["depth_beyond"] == 0.0 and r.series["stopped"] is None
+    assert max(r.series["slip"]) > 0  # the pre-fracture slips where the HF meets it
