@@ -201,6 +201,12 @@ def test_a_confined_fractured_rock_drains_to_the_exact_sticking_state(cut_square
     assert np.abs(u - exact(x)).max() <= 1e-7 * np.abs(exact(x)).max()
     assert np.abs(values @ run.state.x[2 * p.num_nodes:]).max() <= 1e-6 * s_n
     assert (model.fracture.status() == STICK).all()
+    # the model's permeability (the Darcy output's too) holds the closed fracture's k_f0 / 100
+    k = model.permeability(model.committed, model.strain)
+    cover = model.fracture.cover
+    assert cover.size and np.allclose(k[cover], 0.01 * rock.mobility * np.eye(2))
+    others = np.setdiff1d(np.arange(p.num_nodes), cover)
+    assert np.allclose(k[others], rock.mobility * np.eye(2))
     saved = model.state()
     assert "contact_slip" in saved
     model.fracture.slip[:] = 1.0

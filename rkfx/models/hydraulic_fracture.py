@@ -286,9 +286,15 @@ class HydraulicFractureModel(DamageHistory):
         return w
 
     def permeability(self, state: dm.DamageState, strain: np.ndarray) -> np.ndarray:
-        """k_f (5.8) per particle, shape ``(n, 2, 2)`` [m^2/(Pa s)]."""
-        return crack_permeability(self.rock.mobility, state.damage, CrackBands(_unit(state.normal),
-                                  self.band_widths(state)), strain, self.rock.viscosity)
+        """k_f (5.8) per particle, shape ``(n, 2, 2)`` [m^2/(Pa s)]: the crack bands' and, at the
+        particles covering a pre-existing fracture, the fracture's at the last residual (open:
+        (5.8) with w = g_N; closed: k_f0 / 100), their band's enhancement kept."""
+        k = crack_permeability(self.rock.mobility, state.damage, CrackBands(_unit(state.normal),
+                               self.band_widths(state)), strain, self.rock.viscosity)
+        if self.fracture is not None:
+            cover, k_fracture = self.fracture.permeability(self.rock.mobility, self.rock.viscosity)
+            k[cover] += k_fracture - self.rock.mobility * np.eye(2)
+        return k
 
     def pressures(self, x: np.ndarray) -> np.ndarray:
         """p^h at the particles for the unknowns ``x`` [Pa], shape ``(n,)``."""
@@ -338,11 +344,9 @@ class HydraulicFractureModel(DamageHistory):
         f_int = self._bt @ (self.volume[:, None] * stress).ravel() + self._stabilization() @ u
         alpha = self.rock.biot(st.damage)
         self._coupling = (self._div.T @ sp.diags(alpha * self.volume) @ self._values).tocsr()
-        k = self.permeability(st, eps)
         if self.fracture is not None:
-            f_int = f_int + self.fracture.forces(u, P)
-            cover, k_fracture = self.fracture.permeability(self.rock.mobility, self.rock.viscosity)
-            k[cover] += k_fracture - self.rock.mobility * np.eye(2)  # the band's enhancement stays
+            f_int = f_int + self.fracture.forces(u, P)  # before the permeability: it reads the apertures
+        k = self.permeability(st, eps)
         self._kh = laplacian(it.gradient_quads, it.at_points(k, None, gradients=True))
         self._P = P
         f_ext, q_ext = self._loads(t)
