@@ -85,14 +85,14 @@ def test_the_cli_refuses_a_fem_only_run_in_one_line():
     assert len(out.stderr.strip().splitlines()) == 1
 
 
-def _run(test):
-    return case.run(methods=("rkpm",), **_params(tests=[test]))
+def _run(test, **kw):
+    return case.run(methods=("rkpm",), **_params(tests=[test]), **kw)
 
 
-def test_ct8_crosses_the_pre_fracture():
+def test_ct8_crosses_the_pre_fracture(tmp_path):
     """CT-8 (60 deg, 20/5 MPa, 15 MPa): the HF runs through the intersection and beyond it
     (measured at h = 5 mm: through in 13.5 ms, 95 mm beyond, 73 Newton iterations, 46 s)."""
-    res = _run("CT-8")
+    res = _run("CT-8", vtk=tmp_path)
     (r,) = res.runs
     assert r.info["mode"] == "cross" and r.info["crossed"] == 1 == r.info["observed_crossed"]
     assert r.info["depth_beyond"] > 10 * r.info["h"] and r.series["stopped"] is None
@@ -100,6 +100,11 @@ def test_ct8_crosses_the_pre_fracture():
     x, w = np.asarray(r.series["x"]), np.asarray(r.series["opening"])
     assert np.abs(x[w >= case.CRACKED, 1]).max() < 0.05  # the crack stays along sigma_H
     assert r.info["rp"] == "cross" and r.info["gw"] == "arrest"
+    # --vtk: the fields at the pressurization, every 10 growth steps and at the end
+    pvd = (tmp_path / "rkpm_CT-8_h0.005_particles.pvd").read_text()
+    steps = int(round(r.info["growth_ms"] / 1e3 / case.PARAMS["dt"].default))
+    assert pvd.count("<DataSet") == steps // case.VTK_EVERY + 1 + (steps % case.VTK_EVERY != 0)
+    assert (tmp_path / "rkpm_CT-8_h0.005_cells.pvd").is_file()
 
 
 @pytest.mark.slow

@@ -85,7 +85,11 @@ t_confine, t_drain, t_ramp, dt, t_grow, margin, tol, radius, jacobian, damage_up
 support_factor, max_cuts. Long runs: ``--checkpoint-every N`` and ``--resume DIR`` (one folder
 per test and spacing).
 
-    python -m rkfx.cases.blanton [--quick] [--set NAME=VALUE] [--out DIR]
+    python -m rkfx.cases.blanton [--quick] [--set NAME=VALUE] [--out DIR] [--vtk]
+
+With ``--vtk`` every test writes displacement [m], pressure [Pa], damage, crack opening w / w_c
+and the smeared strain at the particles and on their cells, at the pressurization, every 10
+growth steps and at the end, to OUT/vtk/rkpm_<test>_h<h>_particles.pvd / _cells.pvd.
 """
 import sys
 import time
@@ -112,6 +116,8 @@ from rkfx.geometry.gmsh_nodes import from_gmsh, scratch_model
 from rkfx.geometry.gmsh_plates import clip_to_square, fractured_square
 from rkfx.geometry.particles import cut_triangulation
 from rkfx.models.hydraulic_fracture import JACOBIANS, FracturingRock, HydraulicFractureModel
+from rkfx.output.paraview import FieldSeries
+from rkfx.output.paraview import nodal_cells as vtk_cells
 from rkfx.report.claims import Claim
 from rkfx.solvers.integrate import integrate, time_grid
 from rkfx.solvers.newmark import damped
@@ -122,6 +128,7 @@ NAME = "blanton"
 CRACKED = 0.5              # w / w_c from which a particle counts as cracked (as in chapter 4)
 CROSS_DEPTH = 3.0          # spacings beyond the pre-fracture that a crossing crack must reach
 LINK = 1.6                 # spacings between neighbours of one crack (a cluster of cracked particles)
+VTK_EVERY = 10             # growth steps between the ParaView outputs (--vtk)
 OPEN_LENGTH = 4.0          # spacings of opened pre-fracture that make the mode "open"
 REACH = 2.0                # spacings from the pre-fracture within which the HF has met it
 RKPM_BYTES_PER_NODE = 60e3  # as the injection case (same operators) plus the fracture's rows
@@ -253,12 +260,14 @@ def _tractions(sx, sy) -> list[Traction]:
 
 # ----------------------------------------------------------------------------------------- records
 class _Record:
-    """Per committed step: cracked particles, the pre-fracture's state, Newton, the borehole's p."""
+    """Per committed step: cracked particles, the pre-fracture's state, Newton, the borehole's p;
+    with ``series``, the particle fields for ParaView from ``t_press`` on."""
 
     KEYS = ("t", "cracked", "open", "stick", "slip", "aperture", "iterations", "borehole_p")
 
-    def __init__(self, model: HydraulicFractureModel, block: Block):
-        self.model, self.block = model, block
+    def __init__(self, model: HydraulicFractureModel, block: Block, series: FieldSeries | None = None,
+                 t_press: float = 0.0, dt: float = 1.0):
+        self.model, self.block, self.series, self.t_press, self.dt = model, block, series, t_press, dt
         self.rows = {k: [] for k in self.KEYS}
         self._seen = 0
         self.last = None
@@ -278,6 +287,17 @@ class _Record:
                   spent, float(m.pressures(s.x)[self.block.notch].max()))
         for k, v in zip(self.KEYS, values):
             self.rows[k].append(v)
+        grown = int(round((s.t - self.t_press) / self.dt)) if s.t >= self.t_press - 1e-12 else -1
+        if self.series is not None and grown >= 0 and grown % VTK_EVERY == 0:
+            self.write_fields(s)
+
+    def write_fields(self, s) -> None:
+        """The particle fields at the committed step ``s``."""
+        m = self.model
+        st = m.committed
+        self.series.write(s.t, displacement=m.displacements(s.x), pressure=m.pressures(s.x), damage=st.damage,
+                          crack_opening=dm.crack_opening(st.kappa, m.points.kappa0, st.kappa_c),
+                          strain=m.strain * [1.0, 1.0, 0.5])
 
     def arrays(self):
         return {f"row_{k}": np.array(v) for k, v in self.rows.items()}
@@ -315,8 +335,9 @@ def classify(block: Block, cracked: np.ndarray, open_length: float) -> tuple[str
 # ----------------------------------------------------------------------------------------- a test
 def solve_test(name: str, h: float, *, rock, side, offset, notch, mu, penalty, t_confine, t_drain, t_ramp, dt,
                t_grow, margin, tol, radius, jacobian, damage_update, support_factor, max_cuts, ck=None,
-               comm=None) -> dict:
-    """One test of Table 5.1 at spacing ``h`` (module docstring)."""
+               comm=None, vtk=None) -> dict:
+    """One test of Table 5.1 at spacing ``h`` (module docstring); with ``vtk`` a folder, the
+    particle fields at the pressurization, every VTK_EVERY growth steps and at the end."""
     wall = time.perf_counter()
     test = TESTS[name]
     geo = Block(h, side=side, offset=offset, theta=test.theta, notch=notch, support_factor=support_factor)
@@ -334,7 +355,9 @@ def solve_test(name: str, h: float, *, rock, side, offset, notch, mu, penalty, t
         contact=FrictionalContact(k_N=penalty * rock.E / h, k_T=penalty * rock.E / h, mu=mu), fracture="fracture",
         damage_update=damage_update)
     times = _step_times(t_confine, t_press, t_ramp, dt, t_grow)
-    rec = _Record(model, geo)
+    series = None if vtk is None else FieldSeries(vtk, f"rkpm {name} h={h:g}", geo.p.x, cells=vtk_cells(geo.p),
+                                                  comm=comm)
+    rec = _Record(model, geo, series, t_press, dt)
 
     def until(s):
         return s.t > t_press + t_ramp and bool(np.any(rec.cracked() & (geo.edge_distance < margin)))
@@ -353,6 +376,8 @@ def solve_test(name: str, h: float, *, rock, side, offset, notch, mu, penalty, t
         state, cuts, ended = rec.last, None, False
         if state is None:
             raise
+    if series is not None and (not series.entries["particles"] or series.entries["particles"][-1][0] != state.t):
+        rec.write_fields(state)
     cracked = rec.cracked() & ~geo.notch_mask
     f = model.fracture
     status = f.status()
@@ -398,7 +423,8 @@ def run(*, methods: Sequence[str] = ("rkpm",), E=1e10, nu=0.22, rho_s=1900.0, rh
         tests=tuple(TESTS), h=(5e-3, 3.5e-3), mu=0.7, penalty=1.0, t_confine=100.0, t_drain=100.0, t_ramp=0.01,
         dt=5e-4, t_grow=0.2, margin=0.015, tol=0.3, radius=3.5, jacobian="symmetric", damage_update="impl-ex",
         support_factor=1.5, max_cuts=8, checkpoint_every=0, work_dir=None, resume=None, vtk=None) -> Results:
-    """Every test at every spacing; see the module docstring."""
+    """Every test at every spacing; see the module docstring. ``vtk``: a folder for the ParaView
+    files (``--vtk``)."""
     material = dict(E=E, nu=nu, rho_s=rho_s, rho_w=rho_w, porosity=porosity, k_h=k_h, gamma_w=gamma_w, K_w=K_w,
                     K_s=K_s, GF=GF, ft=ft, viscosity=viscosity)
     setup = dict(side=side, offset=offset, notch=notch, mu=mu, penalty=penalty, t_confine=t_confine,
@@ -415,7 +441,7 @@ def run(*, methods: Sequence[str] = ("rkpm",), E=1e10, nu=0.22, rho_s=1900.0, rh
         for hh in sorted(h, reverse=True):
             label = f"rkpm {name} h={hh:g}"
             with _cli.model_run(label):
-                s = solve_test(name, hh, rock=rock, **setup, ck=ck, comm=_cli.comm())
+                s = solve_test(name, hh, rock=rock, **setup, ck=ck, comm=_cli.comm(), vtk=vtk)
             t, pred, rows = s["test"], predictions[name], s["rows"]
             info = {"family": "rkpm", "test": name, "h": hh, "particles": s["particles"], "mode": s["mode"],
                     "observed": t.observed, "rp": pred.rp, "gw": pred.gw, "opens_by_stress": pred.opens,
