@@ -502,7 +502,8 @@ def initiate(model: DamageModel, points: np.ndarray, effective: np.ndarray, norm
     if model.regularized:
         c = chord_lengths(model.geometry, points, normal[at])
         # A point on a cell's boundary whose line across n_L leaves the cell at once (a particle
-        # on a cut face) has no chord; it takes the cell's size sqrt(V_L), as its band width does.
+        # on a cut face, a notch reaching a boundary) has no chord; it takes the cell's size
+        # sqrt(V_L), for kappa_c (4.28) and for the band width V_L / A_L of chapter 5 alike.
         chord[at] = np.where(c > 0, c, np.sqrt(model.volume[points]))
         kappa_c[at] = model.band_factor * critical_strain(model.material, chord[at], model.volume[points])
 

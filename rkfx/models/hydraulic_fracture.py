@@ -275,14 +275,11 @@ class HydraulicFractureModel(DamageHistory):
 
     def band_widths(self, state: dm.DamageState) -> np.ndarray:
         """L_s = V_I / A_I of the damaged particles (1 elsewhere, unused), shape ``(n,)`` [m]; a
-        boundary particle whose chord along its crack is 0 (the crack runs along the boundary)
-        takes sqrt(V_I)."""
+        particle without chord along its crack has A_I = sqrt(V_I) from its initiation
+        (``rkfx.fracture.damage.initiate``)."""
         w = np.ones(self.n)
         on = np.flatnonzero(state.damaged)
-        if on.size:
-            chord = state.chord[on]
-            ok = chord > 0
-            w[on] = np.where(ok, self.volume[on] / np.where(ok, chord, 1.0), np.sqrt(self.volume[on]))
+        w[on] = self.volume[on] / state.chord[on]
         return w
 
     def permeability(self, state: dm.DamageState, strain: np.ndarray) -> np.ndarray:
