@@ -231,8 +231,8 @@ class Block:
         self.rk = rk_approximation(self.p.x, self.p.spacing, support_factor, cracks=cracks)
         self.domains = nodal_cells(self.p)
         x = self.p.x
-        on = 1e-9 * side
-        self.notch_mask = (np.abs(x[:, 1]) < on) & (np.abs(x[:, 0]) <= notch + on)
+        self._notch_end = notch
+        self.notch_mask = self.in_notch(x)
         self.notch = np.flatnonzero(self.notch_mask)
         a, b = self.segment
         t = (b - a) / np.linalg.norm(b - a)
@@ -242,6 +242,11 @@ class Block:
         self.x = x
         self.intersection = np.array([offset, 0.0])            # where the HF's line meets the pre-fracture
         self.edge_distance = side / 2 - np.abs(x).max(axis=1)
+
+    def in_notch(self, x: np.ndarray) -> np.ndarray:
+        """Points of ``x`` on the notch's mesh line (y = 0, |x| <= notch)."""
+        on = 1e-9 * self.side
+        return (np.abs(x[:, 1]) < on) & (np.abs(x[:, 0]) <= self._notch_end + on)
 
 
 PLATENS = [Displacement("left", 0.0, (0,)), Displacement("bottom", 0.0, (1,))]
@@ -345,7 +350,7 @@ def solve_test(name: str, h: float, *, rock, side, offset, notch, mu, penalty, t
     sx = _History([0.0, t_confine], [0.0, test.sigma_H])
     sy = _History([0.0, t_confine], [0.0, test.sigma_h])
     pb = _History([t_press, t_press + t_ramp], [0.0, test.pressure])
-    borehole = Region(lambda x, pts=geo.p.x[geo.notch]: _at(x, pts, 1e-9 * side), "borehole")
+    borehole = Region(geo.in_notch, "borehole")
     model = HydraulicFractureModel(
         geo.p, geo.rk, geo.domains, rock, displacements=PLATENS,
         pressures=[Pressure(borehole, lambda x, t: np.full(len(x), pb(t)))]
@@ -401,12 +406,6 @@ class _History:
 
     def __call__(self, t: float) -> float:
         return float(np.interp(t, self.times, self.values))
-
-
-def _at(x: np.ndarray, points: np.ndarray, tol: float) -> np.ndarray:
-    """Points of ``x`` that coincide with one of ``points`` (within ``tol``)."""
-    d, _ = cKDTree(points).query(np.atleast_2d(x))
-    return d <= tol
 
 
 def _step_times(t_confine, t_press, t_ramp, dt, t_grow) -> np.ndarray:
