@@ -52,17 +52,6 @@ def test_refinement_reduces_the_error(quick):
     assert levels["fem-taylor-hood h=0.14"] < levels["fem-taylor-hood h=0.2"]
 
 
-def test_time_to_accuracy_interpolates_between_levels():
-    R = cryer.Run
-    runs = [R("rkpm-scni+fpp h=0.1", 10.0, 100, errors={"history_max": 0.02}, info={"refinement": True}),
-            R("fem-taylor-hood h=0.2", 1.0, 50, errors={"history_max": 0.04}, info={"refinement": True}),
-            R("fem-taylor-hood h=0.1", 4.0, 200, errors={"history_max": 0.01}, info={"refinement": True})]
-    (row,) = cryer.time_to_accuracy(runs)
-    assert row["error"] == 0.02 and row["rkpm_wall_s"] == 10.0
-    assert row["fem_wall_s"] == pytest.approx(2.0) and row["fem_dofs"] == 100  # halfway in log-log
-    assert row["wall_ratio"] == pytest.approx(5.0)
-
-
 def test_bad_parameters_are_refused_in_one_line():
     with pytest.raises(cryer.InputError, match="mesh size 0.8 must lie in"):
         cryer.check(**{**{k: p.default for k, p in cryer.PARAMS.items()}, "mesh_size": 0.8})

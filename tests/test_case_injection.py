@@ -62,6 +62,37 @@ def test_newton_converges_and_refinements_are_compared(quick):
         assert r.info["cuts"] == 0 and r.info["max_iterations"] <= 10
         assert len(r.series["iterations"]) == len(r.series["t"])
     assert 0 < quick.runs[-1].errors["p_l2_vs_coarser"] < 0.2
+    # Against the finest run, at its last map time: the same two maps, the same norm.
+    coarse, fine = quick.runs
+    assert coarse.errors["p_l2_vs_finest"] == fine.errors["p_l2_vs_coarser"] and coarse.info["vs_finest_at_t"] == 2000.0
+    assert "p_l2_vs_finest" not in fine.errors
+    assert "time_to_accuracy" not in quick.params  # one difference per method: nothing to match
+
+
+def _fake(method, h, p, length, wall, dofs, t=(1000.0, 2000.0)):
+    """A finished run of the case's shape: maps of p at the times t, the tips at +-length/2."""
+    return case.Run(f"{method} h={h:g}", wall, dofs, info={"h": h},
+                    series={"map_t": list(t), "map_p": [np.asarray(p) * 0.5, np.asarray(p)],
+                            "t": list(t), "right": [length / 2] * len(t), "left": [-length / 2] * len(t)})
+
+
+def test_every_run_is_compared_with_its_methods_finest_for_the_time_to_accuracy_table():
+    rk = [_fake("rkpm", 0.04, [1.2, 1.0], 0.4, 2.0, 300), _fake("rkpm", 0.02, [1.1, 1.0], 0.5, 8.0, 1200),
+          _fake("rkpm", 0.01, [1.0, 1.0], 0.5, 40.0, 4800)]
+    # The finest FEM run stopped before 2000 s: its family is compared at its last map, 1000 s.
+    fem = [_fake("fem", 0.04, [1.4, 1.0], 0.8, 1.0, 300), _fake("fem", 0.02, [1.05, 1.0], 0.9, 3.0, 1200),
+           _fake("fem", 0.01, [1.0, 1.0], 1.0, 12.0, 4800, t=(1000.0,))]
+    for family in (rk, fem):
+        case._versus_finest(family)
+    assert rk[0].errors["p_l2_vs_finest"] == pytest.approx(0.2 / np.sqrt(2))
+    assert rk[0].errors["length_vs_finest"] == pytest.approx(0.4 / 0.5 - 1) and rk[0].info["vs_finest_at_t"] == 2000.0
+    assert fem[1].errors["p_l2_vs_finest"] == pytest.approx(0.05 / np.sqrt(2)) and fem[1].info["vs_finest_at_t"] == 1000.0
+    assert "p_l2_vs_finest" not in rk[2].errors and "p_l2_vs_finest" not in fem[2].errors
+    # RKPM's 0.141 and 0.0707 lie within FEM's range (0.0354-0.283); FEM's lie outside RKPM's.
+    rows = case.matched(rk + fem, "p_l2_vs_finest")
+    assert [(r["level_of"], round(r["error"], 4)) for r in rows] == [("rkpm", 0.1414), ("rkpm", 0.0707)]
+    assert rows[0]["fem_wall_s"] == pytest.approx(np.exp(np.interp(np.log(0.1414), np.log([0.0354, 0.2828]),
+                                                                    np.log([3.0, 1.0]))), rel=1e-3)
 
 
 @pytest.fixture(scope="module")
@@ -124,3 +155,27 @@ def test_a_run_that_stops_keeps_what_it_reached(monkeypatch):
     r = case.run(methods=("rkpm",), **_params(h=[0.05])).runs[0]
     assert "step 11" in r.series["stopped"] and r.info["t_reached"] == 1000.0
     assert len(r.series["t"]) == 10 and len(r.series["map_t"]) == 1  # the 1000 s map, not the 2000 s one
+
+
+def test_rate_driven_injection_raises_the_notch_pressure_until_the_crack_grows():
+    """Fluid injected at Q = 2.75e-7 t m^2/s into the notch (its pressure free), residual 1e-4:
+    measured onset at 2900 s (p 1.02e8 Pa), at most 6 Newton iterations per step, no cut."""
+    res = case.run(methods=("rkpm",), **_params(h=[0.025], injection_rate=2.75e-7, residual=1e-4, t_end=3000.0,
+                                                t_out=[3000.0]))
+    (r,) = res.runs
+    p, right = np.asarray(r.series["notch_p"]), np.asarray(r.series["right"])
+    assert r.series["stopped"] is None and r.info["cuts"] == 0 and r.info["max_iterations"] <= 8
+    onset = r.info["onset_t"]
+    assert onset is not None and 2000.0 < onset < 3000.0 and r.info["onset_p"] > res.params["p_lefm"]
+    assert np.all(np.diff(p) > 0)  # the leak-off rises with the pressure: it climbs, ever more slowly
+    np.testing.assert_allclose(right, -np.asarray(r.series["left"]), atol=1e-12)
+    assert right[-1] > res.params["c"] + r.info["h"]
+
+
+def test_rate_driven_injection_is_rkpm_only_and_needs_a_positive_rate():
+    with pytest.raises(case.InputError, match="FEM baseline takes the notch pressure only"):
+        case.check(**(_params(injection_rate=1e-7) | {"methods": ("rkpm", "fem")}))
+    with pytest.raises(case.InputError, match="injection_rate = -1"):
+        case.check(**_params(injection_rate=-1.0))
+    with pytest.raises(case.InputError, match="residual = 0"):
+        case.check(**_params(residual=0.0))

@@ -63,6 +63,7 @@ import numpy as np
 from verification.cryer import Cryer
 
 from rkfx.cases import _cli, _paraview, _preflight, _up_solver
+from rkfx.cases._accuracy import matched
 from rkfx.cases._cli import Param, Results, Run
 from rkfx.conditions import Displacement, Pressure, Traction
 from rkfx.errors import InputError
@@ -330,38 +331,9 @@ def _refinement(results, methods, material, exact, bcs, times, samples, rkpm_lev
                    info={"study": "refinement", "nodes": p.num_nodes, "mesh_size": h, "refinement": True})
         _history_errors(run_, exact, T, ph[:, 0], [])
         results.runs.append(run_)
-    matched = time_to_accuracy(results.runs)
-    if matched:
-        results.params["time_to_accuracy"] = matched
-
-
-def time_to_accuracy(runs: Sequence[Run], key: str = "history_max") -> list[dict]:
-    """Wall times and unknowns of the RKPM and FEM refinement runs at the same error: for every
-    level of either method whose error lies within the other's range, the other's wall time and
-    unknowns interpolated in log-log between its levels. Rows by decreasing error."""
-    def curve(prefix):
-        rows = sorted((r.errors[key], r.wall_time_s, r.n_dofs) for r in runs
-                      if r.info.get("refinement") and r.method.startswith(prefix))
-        return np.array(rows) if rows else np.zeros((0, 3))
-
-    def at(c, err):  # the wall time and unknowns of curve c at error err
-        le = np.log(c[:, 0])
-        return tuple(float(np.exp(np.interp(np.log(err), le, np.log(c[:, j])))) for j in (1, 2))
-
-    rk, fe = curve("rkpm"), curve("fem")
-    out = []
-    for mine, other, name in ((rk, fe, "rkpm"), (fe, rk, "fem")):
-        for err, wall, dofs in mine:
-            if len(other) < 2 or not other[0, 0] <= err <= other[-1, 0]:
-                continue
-            o_wall, o_dofs = at(other, err)
-            row = {"error": float(err), "level_of": name}
-            row.update({f"{name}_wall_s": float(wall), f"{name}_dofs": int(dofs)})
-            o = "fem" if name == "rkpm" else "rkpm"
-            row.update({f"{o}_wall_s": o_wall, f"{o}_dofs": int(round(o_dofs))})
-            row["wall_ratio"] = row["rkpm_wall_s"] / row["fem_wall_s"]
-            out.append(row)
-    return sorted(out, key=lambda row: -row["error"])
+    table = matched(results.runs, "history_max", lambda r: r.info.get("refinement"))
+    if table:
+        results.params["time_to_accuracy"] = table
 
 
 def plot(results: Results, out: Path) -> list[Path]:

@@ -16,6 +16,19 @@ Biot coefficient. With these moduli the skeleton's bulk modulus K = E / (3 (1 - 
 1.75e11 Pa exceeds K_s, so 1 - (1 - D) K / K_s would be negative; the run takes alpha = 1
 (``alpha``) and 1/Q = n_f / K_w + (alpha - n_f) / K_s.
 
+Rate-driven loading (``injection_rate`` > 0). Practitioners drive a fracture by the injected
+rate: fluid then enters the notch's particles at Q = injection_rate t [m^2/s per metre of
+thickness], shared by their volumes (``HydraulicFractureModel(injection=)``), in place of the
+notch pressure, which becomes an unknown (reported at the notch's centre). The notch's particles
+then carry the flow, with the cubic-law permeability of their smeared opening; inside the band
+that opening is held only by the residual stiffness ``residual`` E, and at 1e-6 (the default,
+the seed's low residual strength) it is nearly undetermined: Newton's pressure rows stall with
+an exact Jacobian and a full step that multiplies the residual (measured at h = 0.025 m:
+the run stops at 1435 s). With ``residual`` = 1e-4 the same run steps to 3000 s with at most 6
+Newton iterations per step; under the notch pressure the quick runs with 1e-4 and 1e-6 give the
+same onset, tips and Newton iterations and pressures within 1.4e-4 (relative L2). Rate-driven
+runs take ``--set residual=1e-4``. The crack-band FEM baseline takes the notch pressure only.
+
 Model (``rkfx.models.hydraulic_fracture``). A square grid of particles of spacing h (a row on
 the notch, ``h`` list of refinements, each dividing c and L/2), rectangular SCNI cells with the
 MSCNI subcells, support 1.5 h. The notch is smeared like Sneddon's crack (``rkfx.cases.sneddon``,
@@ -37,7 +50,11 @@ notch: time and notch pressure) beside a strength estimate (p_bar = f_t) and an 
 step, the maps of pressure and crack opening w / w_c at ``t_out`` (Fig 5.6; D is stored too, but
 once kappa_c >> kappa0 it reaches 0.5 long before a particle has opened, chapter 4) and the
 Darcy velocity q = -k_f grad p at the end (Fig 5.7). Between the two finest runs: the relative
-L2 difference of p on a common sample grid and the crack lengths at t_end. A refinement whose
+L2 difference of p on a common sample grid and the crack lengths at t_end. Every run against its
+method's finest run, at that run's last map time: ``p_l2_vs_finest`` and ``length_vs_finest``;
+with three or more spacings per method these make the time-to-accuracy table
+(``params["time_to_accuracy"]``: each run's wall time beside the other method's, interpolated
+in log-log, at the same difference from its finest run; ``rkfx.cases._accuracy``). A refinement whose
 Newton fails at the smallest cut keeps what it reached (``t_reached``, the message in its
 ``stopped`` series) and the case goes on to the next.
 
@@ -58,7 +75,7 @@ always have (at h = 0.025 m both starts take the same 93 iterations).
 
 Parameters (``--set NAME=VALUE``, SI units): E, nu, rho_s, rho_w, porosity, k_h, gamma_w, K_w,
 K_s, GF, ft, viscosity, alpha, L, c, rate, t_end, dt, t_out, h, fem_h, tol, radius, jacobian,
-damage_update, support_factor. Long runs: ``--checkpoint-every N`` and ``--resume DIR``.
+damage_update, support_factor, max_cuts, residual, injection_rate. Long runs: ``--checkpoint-every N`` and ``--resume DIR``.
 
     python -m rkfx.cases.injection [--quick] [--method rkpm|both] [--set NAME=VALUE] [--out DIR] [--vtk]
 
@@ -77,6 +94,7 @@ from scipy.spatial import cKDTree
 
 from rkfx.approximation.shape_functions import evaluate, rk_approximation
 from rkfx.cases import _cli, _preflight
+from rkfx.cases._accuracy import matched
 from rkfx.cases._cli import Param, Results, Run
 from rkfx.report.claims import Claim
 from rkfx.conditions import Displacement, Pressure, Region
@@ -132,6 +150,10 @@ PARAMS = {
     "damage_update": Param("implicit", "implicit (every Newton iterate) or impl-ex (extrapolated over a step)"),
     "support_factor": Param(1.5, "RK support radius / spacing [-]"),
     "max_cuts": Param(12, "halvings of a step whose Newton fails before the run stops [-]"),
+    "residual": Param(1e-6, "stiffness fraction 1 - D left in damaged particles and elements [-], in (0, 1)"),
+    "injection_rate": Param(0.0, "rate-driven loading: fluid injected into the notch's particles at Q = "
+                                 "injection_rate t [m^2/s^2, per metre of thickness] in place of the notch "
+                                 "pressure; 0: the seed's p_bar = rate t (see the docstring)"),
 }
 QUICK = {"h": [0.05, 0.025], "fem_h": [0.05, 0.025], "dt": 100.0, "t_end": 2000.0, "t_out": [1000.0, 2000.0]}
 
@@ -141,7 +163,8 @@ def _intervals(length: float, h: float) -> int:
 
 
 def check(*, L, c, h, dt, t_end, t_out, tol, radius, jacobian, support_factor, rate, max_cuts=12,
-          damage_update="implicit", methods=("rkpm",), fem_h=(), **material) -> None:
+          damage_update="implicit", residual=1e-6, injection_rate=0.0, methods=("rkpm",), fem_h=(),
+          **material) -> None:
     """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
     spacings = [("h", hh) for hh in h] + ([("fem_h", hh) for hh in fem_h] if "fem" in methods else [])
     _rock(**{k: material[k] for k in ("E", "nu", "rho_s", "rho_w", "porosity", "k_h", "gamma_w", "K_w", "K_s",
@@ -165,6 +188,15 @@ def check(*, L, c, h, dt, t_end, t_out, tol, radius, jacobian, support_factor, r
         raise InputError(f"jacobian = {jacobian!r}; choose one of {', '.join(JACOBIANS)}")
     if damage_update not in DAMAGE_UPDATES:
         raise InputError(f"damage_update = {damage_update!r}; choose one of {', '.join(DAMAGE_UPDATES)}")
+    if not 0.0 < residual < 1.0:
+        raise InputError(f"residual = {residual!r}: the stiffness fraction left in damaged particles must lie in "
+                         "(0, 1), e.g. 1e-4")
+    if not (np.isfinite(injection_rate) and injection_rate >= 0.0):
+        raise InputError(f"injection_rate = {injection_rate!r}: the injected rate must grow (> 0), or 0 for the "
+                         "notch pressure")
+    if injection_rate > 0 and "fem" in methods:
+        raise InputError("injection_rate: the crack-band FEM baseline takes the notch pressure only; run "
+                         "--method rkpm, or set injection_rate=0")
     check_tracking(tol, radius)
     _preflight.support_factor_ok(support_factor)
 
@@ -265,7 +297,7 @@ class _Record:
 
 
 def solve(h: float, *, L, c, rate, t_end, dt, t_out, tol, radius, jacobian, support_factor, rock, max_cuts=12,
-          damage_update="implicit", io=None, comm=None, vtk=None) -> dict:
+          damage_update="implicit", residual=1e-6, injection_rate=0.0, io=None, comm=None, vtk=None) -> dict:
     """One refinement: the crack history, maps and Darcy velocity (see the module docstring); with
     ``vtk`` a folder, the particle fields at the times ``t_out`` are written there."""
     t0 = time.perf_counter()
@@ -281,12 +313,16 @@ def solve(h: float, *, L, c, rate, t_end, dt, t_out, tol, radius, jacobian, supp
         return (np.abs(x[:, 1]) < support_factor * h - tol_x) & (np.abs(x[:, 0]) <= c + tol_x)
 
     notch = in_notch(p.x)
+    region = Region(in_notch, "notch")
+    if injection_rate > 0:  # the fluid enters the notch's particles; their pressure is free
+        loading = {"injection": (region, lambda t: injection_rate * t)}
+    else:
+        loading = {"pressures": [Pressure(region, lambda x, t: np.full(len(x), rate * t))]}
     model = HydraulicFractureModel(
         p, rk, domains, rock, displacements=[Displacement(s) for s in SIDES],
-        pressures=[Pressure(Region(in_notch, "notch"), lambda x, t: np.full(len(x), rate * t))]
-        + [Pressure(s) for s in SIDES], precracked=np.flatnonzero(notch), jacobian=jacobian,
-        damage_update=damage_update,
-        track=tracking(p.x, p.spacing, tol, seeds=notch, radius=radius))
+        pressures=loading.pop("pressures", []) + [Pressure(s) for s in SIDES], precracked=np.flatnonzero(notch),
+        jacobian=jacobian, damage_update=damage_update, residual=residual,
+        track=tracking(p.x, p.spacing, tol, seeds=notch, radius=radius), **loading)
     samples = _sample_grid(L)
     step = max(1, int(math.ceil((N + 1) / MAP_MAX)))
     keep = np.arange(0, N + 1, step)
@@ -327,14 +363,16 @@ def run(*, methods: Sequence[str] = ("rkpm",), E=2.1e11, nu=0.3, rho_s=3000.0, r
         k_h=1e-8, gamma_w=1e4, K_w=2e9, K_s=1e11, GF=2.7e3, ft=2.1e7, viscosity=1e-3, alpha=1.0, L=1.0, c=0.1,
         rate=5.5e4, t_end=4000.0, dt=50.0, t_out=(1000.0, 2000.0, 3000.0, 4000.0), h=(5e-3, 2.5e-3),
         fem_h=(5e-3, 2.5e-3), tol=0.3,
-        radius=3.5, jacobian="full", damage_update="implicit", support_factor=1.5, max_cuts=12, checkpoint_every=0,
+        radius=3.5, jacobian="full", damage_update="implicit", support_factor=1.5, max_cuts=12, residual=1e-6,
+        injection_rate=0.0, checkpoint_every=0,
         work_dir=None, resume=None,
         vtk=None) -> Results:
     """Every refinement; see the module docstring. ``vtk``: a folder for the ParaView files (``--vtk``)."""
     material = dict(E=E, nu=nu, rho_s=rho_s, rho_w=rho_w, porosity=porosity, k_h=k_h, gamma_w=gamma_w, K_w=K_w,
                     K_s=K_s, GF=GF, ft=ft, viscosity=viscosity, alpha=alpha)
     setup = dict(L=L, c=c, rate=rate, t_end=t_end, dt=dt, t_out=list(t_out), tol=tol, radius=radius,
-                 jacobian=jacobian, damage_update=damage_update, support_factor=support_factor, max_cuts=max_cuts)
+                 jacobian=jacobian, damage_update=damage_update, support_factor=support_factor, max_cuts=max_cuts,
+                 residual=residual, injection_rate=injection_rate)
     check(h=list(h), methods=tuple(methods), fem_h=list(fem_h), **setup, **material)
     rock = _rock(**material)
     est = onset_estimates(rock, c, rate)
@@ -372,12 +410,13 @@ def run(*, methods: Sequence[str] = ("rkpm",), E=2.1e11, nu=0.3, rho_s=3000.0, r
         twin = next((q for q in runs if q.info["h"] == r.info["h"]), None)
         common = [] if twin is None else sorted(set(r.series["map_t"]) & set(twin.series["map_t"]))
         if common:
-            pf = np.asarray(r.series["map_p"][r.series["map_t"].index(common[-1])])
-            pr = np.asarray(twin.series["map_p"][twin.series["map_t"].index(common[-1])])
-            r.errors["p_l2_vs_rkpm"] = float(np.linalg.norm(pf - pr) / np.linalg.norm(pr))
-            r.errors["length_vs_rkpm"] = _length_at(r, common[-1]) / _length_at(twin, common[-1]) - 1.0
-            r.info["vs_rkpm_at_t"] = common[-1]
+            _difference(r, twin, common[-1], "rkpm")
+    for family in (runs, fem_runs):
+        _versus_finest(family)
     results.runs.extend(runs + fem_runs)
+    table = matched(results.runs, "p_l2_vs_finest")
+    if table:
+        results.params["time_to_accuracy"] = table
     return results
 
 
@@ -403,6 +442,31 @@ def _length_at(r: Run, t: float) -> float:
     return float(r.series["right"][i] - r.series["left"][i])
 
 
+def _difference(r: Run, ref: Run, t: float, name: str) -> None:
+    """``errors["p_l2_vs_<name>"]``, the relative L2 difference of p on the sample grid between
+    run ``r`` and the reference run ``ref`` at the map time ``t``, and ``length_vs_<name>``, the
+    crack lengths' ratio less one then."""
+    p, p_ref = (np.asarray(q.series["map_p"][q.series["map_t"].index(t)]) for q in (r, ref))
+    r.errors[f"p_l2_vs_{name}"] = float(np.linalg.norm(p - p_ref) / np.linalg.norm(p_ref))
+    r.errors[f"length_vs_{name}"] = _length_at(r, t) / _length_at(ref, t) - 1.0
+    r.info[f"vs_{name}_at_t"] = t
+
+
+def _versus_finest(runs: list[Run]) -> None:
+    """Every run of one method against the method's finest run, at the finest run's last map
+    time (runs that did not reach it get no difference): the error of the time-to-accuracy
+    table."""
+    if len(runs) < 2:
+        return
+    finest = min(runs, key=lambda r: r.info["h"])
+    if not finest.series["map_t"]:
+        return
+    t = finest.series["map_t"][-1]
+    for r in runs:
+        if r is not finest and t in r.series["map_t"]:
+            _difference(r, finest, t, "finest")
+
+
 def _compare_refinements(runs: list[Run]) -> None:
     """Relative L2 difference of p at the last map time and the length ratio, finest vs the next
     coarser run of one method, when neither stopped early."""
@@ -414,7 +478,7 @@ def _compare_refinements(runs: list[Run]) -> None:
 
 
 def solve_fem(h: float, *, L, c, rate, t_end, dt, t_out, jacobian, rock, max_cuts=12, damage_update="implicit",
-              io=None, comm=None, **_) -> Run:
+              residual=1e-6, io=None, comm=None, **_) -> Run:
     """One crack-band FEM refinement (``fem_baselines.hydraulic_fracture``) on the particles of
     spacing ``h`` as mesh vertices, reported as the RKPM runs are."""
     import dolfinx_solver  # noqa: F401, PLC0415
@@ -425,7 +489,7 @@ def solve_fem(h: float, *, L, c, rate, t_end, dt, t_out, jacobian, rock, max_cut
     times = _step_times(t_end, dt, t_out)
     samples = _sample_grid(L)
     res = solve_hydraulic_fracture(h, rock, rate, times, L=L, c=c, jacobian=jacobian, damage_update=damage_update,
-                                   output_times=t_out,
+                                   residual=residual, output_times=t_out,
                                    sample_points=samples, max_cuts=max_cuts, comm=comm,
                                    progress=lambda it: _cli.progress(it, label, len(times) - 1), **(io or {}))
     if res.stopped is not None and (comm is None or comm.rank == 0):
@@ -474,7 +538,9 @@ def plot(results: Results, out: Path) -> list[Path]:
         fig.colorbar(im2, ax=axes[1, :].tolist(), shrink=0.8, label="w / w_c [-] (cracked from 0.5)")
         size = (f"{r.info['particles']:,} particles" if "particles" in r.info
                 else f"{r.info['vertices']:,} vertices, {r.info['elements']:,} triangles")
-        fig.suptitle(f"Injection at the notch, p_bar = {prm['rate']:g} t Pa\n{r.method} ({size})", fontsize=10)
+        load = (f"Q = {prm['injection_rate']:g} t m^2/s" if prm.get("injection_rate")
+                else f"p_bar = {prm['rate']:g} t Pa")
+        fig.suptitle(f"Injection at the notch, {load}\n{r.method} ({size})", fontsize=10)
         stem = "maps" if r.method.startswith("rkpm") else "maps_fem"
         files.append(_cli.save(fig, out / f"{stem}_h{r.info['h']:g}.png"))
     darcy = [r for r in results.runs if "arrow_x" in r.series and r.series["map_t"]]
@@ -514,7 +580,8 @@ def _growth(results: Results, out: Path) -> list[Path]:
         axes[0].plot(t, -np.asarray(r.series["left"]), "--", color=colour, label=f"{r.method}, left tip (mirrored)")
         axes[1].plot(t, np.asarray(r.series["iterations"]), ".-", color=colour, label=r.method)
     for style, kind in ((":", "strength"), ("-.", "lefm")):
-        axes[0].axvline(prm[f"t_{kind}"], color="0.4", ls=style, lw=1, label=f"onset by {kind}")
+        if not prm.get("injection_rate"):  # the estimates' times follow the notch pressure's ramp
+            axes[0].axvline(prm[f"t_{kind}"], color="0.4", ls=style, lw=1, label=f"onset by {kind}")
         axes[2].axhline(prm[f"p_{kind}"], color="0.4", ls=style, lw=1, label=f"onset by {kind}")
     for ax, label in zip(axes, ("tip |x| [m] (outermost cracked cell)",
                                 f"Newton iterations per step ({prm['jacobian']} Jacobian)",
