@@ -80,7 +80,11 @@ problem); outer edges fixed and drained; the notch as in the RKPM case: the pres
 p_bar = rate t prescribed at the vertices within 1.5 h of the notch line with |x| <= c (the
 RKPM case's particles), and the elements whose three vertices are among them (|y| <= h,
 |x| <= c: the band the pressurized vertices span) damaged from the start, D = 1 across
-n = (0, 1) (``rkfx.models.hydraulic_fracture.initial_damage``).
+n = (0, 1) (``rkfx.models.hydraulic_fracture.initial_damage``). Rate-driven
+(``injection_rate`` > 0): fluid injected at Q = injection_rate t into those elements, evenly
+over their area, in place of the notch pressure (``FemHydraulicFractureModel(injection=)``;
+with the implicit damage update Newton stops near the strength pressure, at 230-350 s for
+h = 0.05 m with any residual stiffness from 1e-6 to 1e-2; impl-ex runs it through).
 
 Time steps (``stepper``). The seed's trapezoidal rule (beta_2 = 1/4, beta_1 = 1/2, theta = 1/2,
 ``rkfx.solvers.newmark.trapezoidal``), Newton started from the last step's unknowns
@@ -267,6 +271,9 @@ class FemHydraulicFractureModel(DamageHistory):
             particles; ``None``: every element may damage (see the module docstring).
         damage_update: ``"implicit"`` or ``"impl-ex"`` (``rkfx.fracture.history``), as the
             RKPM model.
+        injection: ``(region, rate)``: fluid injected at ``rate(t)`` [m^2/s per metre of
+            thickness] into the elements whose three vertices the region's marker accepts,
+            spread evenly over their area (the RKPM model's ``injection``, shared by volume).
 
     Attributes:
         committed: The committed ``rkfx.fracture.damage.DamageState`` of the elements (element
@@ -284,7 +291,8 @@ class FemHydraulicFractureModel(DamageHistory):
                  precracked: Region | None = None, precrack_normal: Sequence[float] = (0.0, 1.0),
                  element: str = "p1p1-fpp", mass: str = "lumped", jacobian: str = "full",
                  residual: float = RESIDUAL_STIFFNESS, track: tuple[float, float] | None = None,
-                 damage_update: str = "implicit"):
+                 damage_update: str = "implicit",
+                 injection: tuple[Region, Callable[[float], float]] | None = None):
         if not isinstance(rock, FracturingRock):
             raise InputError(f"rock = {rock!r}: give a rkfx.models.hydraulic_fracture.FracturingRock")
         if element not in ELEMENTS:
@@ -327,19 +335,13 @@ class FemHydraulicFractureModel(DamageHistory):
         self._forms(mesh)
         self.points = dm.damage_model(rock.damage_material, self.area, geometry=band_geometry(self.vertices),
                                       band_factor=2.0)
-        self.precracked = np.zeros(self.m, bool)
-        if precracked is not None:
-            if not isinstance(precracked, Region):
-                raise InputError(f"precracked = {precracked!r}: give a rkfx.conditions.Region (elements whose three "
-                                 "vertices it holds are damaged from the start)")
-            inside = np.asarray(precracked.marker(self.vertices.reshape(-1, 2)), bool)
-            if inside.shape != (3 * self.m,):
-                raise InputError(f"region {precracked.name!r}: its marker returned shape {inside.shape} for "
-                                 f"{3 * self.m} points; return a bool array (m,)")
-            self.precracked = inside.reshape(-1, 3).all(axis=1)
-            if not self.precracked.any():
-                raise InputError(f"region {precracked.name!r} holds no element's three vertices; widen it to span "
-                                 "at least one element")
+        self.precracked = np.zeros(self.m, bool) if precracked is None else self._elements_in(precracked, "precracked")
+        self._injection = None
+        if injection is not None:
+            region, rate = injection
+            inside = self._elements_in(region, "injection")
+            share = np.where(inside, 1.0 / self.area[inside].sum(), 0.0)  # per unit area, of a unit volume
+            self._injection = (self._ct.T @ share, rate)  # int_e N_I s dx per unit injected volume
         self.committed = initial_damage(self.points, np.flatnonzero(self.precracked), precrack_normal)
         self.trial: dm.DamageUpdate | None = None
         self.track, self.allowed, self.parent = None, None, np.full(self.m, -1, np.int64)
@@ -363,6 +365,21 @@ class FemHydraulicFractureModel(DamageHistory):
         self._count = 0
 
     # ------------------------------------------------------------------ set-up
+
+    def _elements_in(self, region: Region, what: str) -> np.ndarray:
+        """The elements whose three vertices ``region``'s marker accepts, shape ``(m,)`` bool."""
+        if not isinstance(region, Region):
+            raise InputError(f"{what} = {region!r}: give a rkfx.conditions.Region (the elements whose three "
+                             "vertices it holds)")
+        inside = np.asarray(region.marker(self.vertices.reshape(-1, 2)), bool)
+        if inside.shape != (3 * self.m,):
+            raise InputError(f"region {region.name!r}: its marker returned shape {inside.shape} for "
+                             f"{3 * self.m} points; return a bool array (m,)")
+        inside = inside.reshape(-1, 3).all(axis=1)
+        if not inside.any():
+            raise InputError(f"region {region.name!r} holds no element's three vertices; widen it to span "
+                             "at least one element")
+        return inside
 
     def _element_data(self, mesh: dolfinx.mesh.Mesh) -> None:
         """Areas, vertices and the mean-strain rows of every element, in element order on every rank."""
@@ -529,7 +546,8 @@ class FemHydraulicFractureModel(DamageHistory):
             self._set(fn, k[:, i, j])
         self._kh = _global_matrix(self._a_kh, self.comm)
         self._x = x
-        return np.r_[self._ku @ u - self._kc @ P, self._kh @ P]
+        q_ext = 0.0 if self._injection is None else float(self._injection[1](t)) * self._injection[0]
+        return np.r_[self._ku @ u - self._kc @ P, self._kh @ P - q_ext]
 
     def _damage(self, eps: np.ndarray) -> dm.DamageUpdate:
         """The damage of the elements' strains ``eps``: the trial from the committed state with
@@ -759,7 +777,8 @@ def solve_hydraulic_fracture(h: float, rock: FracturingRock, rate: float = 5.5e4
                              L: float = 1.0, c: float = 0.1, notch_width: float = 1.5,
                              element: str = "p1p1-fpp", mass: str = "lumped", jacobian: str = "full",
                              residual: float = RESIDUAL_STIFFNESS, track: tuple[float, float] | None = None,
-                             damage_update: str = "implicit", output_times: Sequence[float] = (),
+                             damage_update: str = "implicit", injection_rate: float = 0.0,
+                             output_times: Sequence[float] = (),
                              sample_points: np.ndarray | None = None, line_search: bool = True,
                              max_cuts: int = 12, comm: MPI.Comm | None = None, checkpoint_every: int = 0,
                              checkpoint_dir: str | Path | None = None, resume: str | Path | None = None,
@@ -783,6 +802,8 @@ def solve_hydraulic_fracture(h: float, rock: FracturingRock, rate: float = 5.5e4
             (the RKPM case's 1.5 support radii).
         element, mass, jacobian, residual, track, damage_update: As ``FemHydraulicFractureModel`` (``track``:
             ``None``, the default, lets every element damage; ``(0.3, 3.5)`` is the RKPM case's).
+        injection_rate: > 0: fluid injected into the notch's elements at Q = injection_rate t
+            [m^2/s per metre of thickness] in place of the notch pressure (``rate`` then unused).
         output_times: Step times at which p, D and w / w_c are kept.
         sample_points: Where p is sampled at the output times, shape ``(s, 2)`` [m] (default a
             21 x 21 grid over the plate).
@@ -823,11 +844,17 @@ def solve_hydraulic_fracture(h: float, rock: FracturingRock, rate: float = 5.5e4
 
     notch = Region(in_notch, "notch")
     sides = ("left", "right", "bottom", "top")
-    conditions = [Displacement(s) for s in sides] + [Pressure(s) for s in sides] + [
-        Pressure(notch, lambda x, t: np.full(len(x), rate * t))]
+    conditions = [Displacement(s) for s in sides] + [Pressure(s) for s in sides]
+    if not (np.isfinite(injection_rate) and injection_rate >= 0.0):
+        raise InputError(f"injection_rate = {injection_rate!r} must be >= 0 [m^2/s^2] (0: the notch pressure)")
+    injection = None
+    if injection_rate > 0:  # the fluid enters the notch's elements; their pressure is free
+        injection = (notch, lambda t: injection_rate * t)
+    else:
+        conditions.append(Pressure(notch, lambda x, t: np.full(len(x), rate * t)))
     model = FemHydraulicFractureModel(mesh, rock, conditions, precracked=notch, element=element, mass=mass,
                                       jacobian=jacobian, residual=residual, track=track,
-                                      damage_update=damage_update)
+                                      damage_update=damage_update, injection=injection)
     if sample_points is None:
         g = np.linspace(-L / 2, L / 2, 21)
         sample_points = np.column_stack([np.repeat(g, 21), np.tile(g, 21)])

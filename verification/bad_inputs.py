@@ -221,7 +221,6 @@ ROWS: list[Row] = [
                               ("unknown damage update", "damage_update=explicit"),
                               ("no residual stiffness", "residual=0"), ("negative injected rate", "injection_rate=-1")]),
     Row("FEM spacing that does not divide the notch", "injection", ("--method", "fem", "--set", "fem_h=0.03")),
-    Row("rate-driven FEM baseline", "injection", ("--method", "both", "--set", "injection_rate=1e-7")),
     Row("too big for memory", "injection", ("--set", "h=1e-5")),
     *_case_rows("blanton", [("unknown test", "tests=CT-5"),
                             ("notch reaching the pre-fracture", "notch=0.05"),
