@@ -28,7 +28,8 @@ the run stops at 1435 s). With ``residual`` = 1e-4 the same run steps to 3000 s 
 Newton iterations per step; under the notch pressure the quick runs with 1e-4 and 1e-6 give the
 same onset, tips and Newton iterations and pressures within 1.4e-4 (relative L2). Rate-driven
 runs take ``--set residual=1e-4``. The crack-band FEM baseline injects the same rate into the
-notch's elements.
+notch's elements; it needs ``--set damage_update=impl-ex`` (with the implicit update its Newton
+stops near the strength pressure, ``fem_baselines.hydraulic_fracture``).
 
 Model (``rkfx.models.hydraulic_fracture``). A square grid of particles of spacing h (a row on
 the notch, ``h`` list of refinements, each dividing c and L/2), rectangular SCNI cells with the
@@ -312,15 +313,14 @@ def solve(h: float, *, L, c, rate, t_end, dt, t_out, tol, radius, jacobian, supp
 
     notch = in_notch(p.x)
     region = Region(in_notch, "notch")
-    if injection_rate > 0:  # the fluid enters the notch's particles; their pressure is free
-        loading = {"injection": (region, lambda t: injection_rate * t)}
-    else:
-        loading = {"pressures": [Pressure(region, lambda x, t: np.full(len(x), rate * t))]}
+    by_rate = injection_rate > 0  # the fluid enters the notch's particles, whose pressure is then free
     model = HydraulicFractureModel(
         p, rk, domains, rock, displacements=[Displacement(s) for s in SIDES],
-        pressures=loading.pop("pressures", []) + [Pressure(s) for s in SIDES], precracked=np.flatnonzero(notch),
-        jacobian=jacobian, damage_update=damage_update, residual=residual,
-        track=tracking(p.x, p.spacing, tol, seeds=notch, radius=radius), **loading)
+        pressures=([] if by_rate else [Pressure(region, lambda x, t: np.full(len(x), rate * t))])
+        + [Pressure(s) for s in SIDES], precracked=np.flatnonzero(notch), jacobian=jacobian,
+        damage_update=damage_update, residual=residual,
+        track=tracking(p.x, p.spacing, tol, seeds=notch, radius=radius),
+        injection=(region, lambda t: injection_rate * t) if by_rate else None)
     samples = _sample_grid(L)
     step = max(1, int(math.ceil((N + 1) / MAP_MAX)))
     keep = np.arange(0, N + 1, step)
