@@ -7,7 +7,8 @@ solves and the stepper), plus the peak RSS. The issue's target: h = 2.5e-3 m (16
 particles) from 0 to 4000 s within 20 minutes.
 
 Usage:
-    python bench/injection_speed.py [--h 0.01] [--t-end 4000] [--jacobian full]
+    python bench/injection_speed.py [--h 0.01] [--t-end 4000] [--jacobian full] [--damage-update impl-ex]
+        [--injection-rate 2.75e-7 --residual 1e-4]
 """
 import argparse
 import resource
@@ -27,6 +28,10 @@ def main() -> None:
     ap.add_argument("--t-end", type=float, default=4000.0, help="end time [s]")
     ap.add_argument("--dt", type=float, default=50.0, help="time step [s]")
     ap.add_argument("--jacobian", default="full", choices=hf.JACOBIANS)
+    ap.add_argument("--damage-update", default="implicit", choices=case.DAMAGE_UPDATES)
+    ap.add_argument("--injection-rate", type=float, default=0.0,
+                    help="rate-driven: Q = this x t [m^2/s^2] into the notch (0: the notch pressure)")
+    ap.add_argument("--residual", type=float, default=1e-6, help="stiffness fraction left in damaged particles")
     args = ap.parse_args()
     reuse_freed_memory()  # large temporaries reuse freed pages (rkfx.memory)
     warm_up()
@@ -48,11 +53,14 @@ def main() -> None:
     t0 = time.perf_counter()
     s = case.solve(args.h, L=prm["L"], c=prm["c"], rate=prm["rate"], t_end=args.t_end, dt=args.dt,
                    t_out=[args.t_end], tol=prm["tol"], radius=prm["radius"], jacobian=args.jacobian,
-                   support_factor=prm["support_factor"], rock=rock, max_cuts=prm["max_cuts"])
+                   support_factor=prm["support_factor"], rock=rock, max_cuts=prm["max_cuts"],
+                   damage_update=args.damage_update, injection_rate=args.injection_rate, residual=args.residual)
     wall = time.perf_counter() - t0
     assembly = sum(spent.values())
     rows = s["rec"].rows
-    print(f"h = {args.h:g} m: {s['nodes']:,} particles, {s['n_dofs']:,} unknowns, {args.jacobian} Jacobian")
+    load = f"injected Q = {args.injection_rate:g} t m^2/s" if args.injection_rate > 0 else "notch pressure"
+    print(f"h = {args.h:g} m: {s['nodes']:,} particles, {s['n_dofs']:,} unknowns, {args.jacobian} Jacobian, "
+          f"{args.damage_update} damage, {load}, residual stiffness {args.residual:g}")
     print(f"reached t = {rows['t'][-1]:g} s of {args.t_end:g} s" + (f" (stopped: {s['stopped']})" if s["stopped"] else ""))
     print(f"steps {s['steps']}, cuts {s['cuts']}, Newton iterations {s['newton']}, "
           f"per step {np.mean(rows['iterations']):.2f} (max {int(max(rows['iterations']))})")
