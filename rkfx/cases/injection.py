@@ -27,7 +27,8 @@ an exact Jacobian and a full step that multiplies the residual (measured at h = 
 the run stops at 1435 s). With ``residual`` = 1e-4 the same run steps to 3000 s with at most 6
 Newton iterations per step; under the notch pressure the quick runs with 1e-4 and 1e-6 give the
 same onset, tips and Newton iterations and pressures within 1.4e-4 (relative L2). Rate-driven
-runs take ``--set residual=1e-4``. The crack-band FEM baseline injects the same rate into the
+runs take ``--set residual=1e-4`` and the full Jacobian (the symmetrized one drops exactly the
+coupling of the notch's flow to its opening: Newton stops at 512 s at h = 0.05 m). The crack-band FEM baseline injects the same rate into the
 notch's elements; it needs ``--set damage_update=impl-ex`` (with the implicit update its Newton
 stops near the strength pressure, ``fem_baselines.hydraulic_fracture``) and, at h <= 0.01 m,
 ``residual`` = 1e-3 (with 1e-4 its Newton stops at 1426 s), so the two methods side by side take
