@@ -83,8 +83,9 @@ RKPM case's particles), and the elements whose three vertices are among them (|y
 n = (0, 1) (``rkfx.models.hydraulic_fracture.initial_damage``). Rate-driven
 (``injection_rate`` > 0): fluid injected at Q = injection_rate t into those elements, evenly
 over their area, in place of the notch pressure (``FemHydraulicFractureModel(injection=)``;
-with the implicit damage update Newton stops near the strength pressure, at 230-350 s for
-h = 0.05 m with any residual stiffness from 1e-6 to 1e-2; impl-ex runs it through).
+with the implicit damage update Newton stops near the strength pressure, at 265-353 s for
+h = 0.05 m with residual stiffnesses from 1e-6 to 1e-2 and at 228 s for h = 0.025 m; impl-ex
+runs it through).
 
 Time steps (``stepper``). The seed's trapezoidal rule (beta_2 = 1/4, beta_1 = 1/2, theta = 1/2,
 ``rkfx.solvers.newmark.trapezoidal``), Newton started from the last step's unknowns

@@ -290,7 +290,7 @@ def test_injected_fluid_is_stored_exactly(element):
 def test_rate_driven_injection_grows_a_symmetric_crack_with_impl_ex():
     """The case's rate-driven set-up (Q = 2.75e-7 t into the notch's elements, residual 1e-4) at
     h = 0.05 m: measured onset 2600 s at 8.0e7 Pa, at most 9 Newton iterations per step. (With the
-    implicit update Newton stops at 230-350 s near the strength, at any residual 1e-6 to 1e-2.)"""
+    implicit update Newton stops at 265-353 s near the strength, with residuals 1e-6 to 1e-2.)"""
     r = hf.solve_hydraulic_fracture(0.05, ROCK, 5.5e4, np.arange(0.0, 3001.0, 100.0), injection_rate=2.75e-7,
                                     residual=1e-4, damage_update="impl-ex", track=(0.3, 3.5), comm=MPI.COMM_SELF)
     assert r.stopped is None and r.t_reached == 3000.0 and r.iterations.max() <= 12
