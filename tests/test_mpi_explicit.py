@@ -80,3 +80,12 @@ def test_killed_on_two_ranks_resumes_on_two_ranks(serial, tmp_path):
         assert refused.returncode != 0 and lines and word in lines[0], refused.stderr[-2000:]
     kalthoff(2, out, "--resume", str(out))
     assert_same_runs(serial, runs(out))
+
+
+@pytest.mark.parametrize("ranks", [1, 2, 3])
+def test_a_share_runs_stencils_and_is_the_whole_operator(ranks):
+    """Each rank's share evaluates most of its rows as lattice stencils over its box, with the
+    whole operator's strains and forces bit for bit (``tests/mpi/share_stencil.py`` asserts)."""
+    done = mpiexec(ranks, str(ROOT / "tests" / "mpi" / "share_stencil.py"), check=False)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert float(done.stdout.split("coverage")[1]) > 0.3

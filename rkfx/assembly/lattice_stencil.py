@@ -17,9 +17,13 @@ the template to ``TEMPLATE_RTOL`` become the template (``snap_to_template``: a c
 size of the round-off the rows carry). The stencils then add the same numbers in the same
 order as the sparse products over these rows: strains in each row's entry order, forces in
 the row order of each node's transposed row, no fused multiply-adds. Stencil and sparse
-products agree bit for bit, so a run distributed over MPI ranks (sparse products over each
-rank's share, whose rows are sorted and snapped to the same template) is still the serial
-run bit for bit.
+products agree bit for bit.
+
+On MPI ranks each rank's share (``rkfx.assembly.local_strain``) has its rows snapped to the
+same template and runs the same stencils over the box of grid positions its rows and their
+nodes span (``share_stencil``): its local coefficients are scattered into the box, and the
+subcell loads of the ghost rows, received from their owners, are placed there before the
+force stencils run. A distributed run is therefore still the serial run bit for bit.
 
 The template is the rows of one particle every rank can build: the lowest-numbered
 particle farther than its support plus two cell diagonals from the boundary and from every
@@ -121,6 +125,16 @@ class Template:
         return len(self.ptr) - 1
 
 
+@dataclass(frozen=True)
+class Snap:
+    """What snapping a build's rows found: the ``template`` (index shifts on the ``lattice``) and
+    which particles have its rows (``matched``, shape ``(n,)``; only built rows can match)."""
+
+    template: Template
+    lattice: Lattice
+    matched: np.ndarray
+
+
 @numba.njit(parallel=True, cache=True)
 def _sort_rows(indptr, indices, data):
     for row in numba.prange(len(indptr) - 1):
@@ -211,19 +225,35 @@ class LatticeStencil:
     the template rows as stencils, fused with the cell averages and the subcell loads; bit for
     bit the sparse products over the same rows.
 
+    The stencils run over *positions* of a grid numbered row by row: the whole lattice for the
+    whole operator (position = particle = node), or the box of a rank's share
+    (``share_stencil``), into which the local coefficients are scattered and the subcell loads
+    of the ghost rows placed; runs start at a position and write from a point (strains, loads)
+    or a node (force) of the operator's own numbering.
+
     Attributes:
-        template: The rows every matched particle has (``Template``), entries by column.
-        strain_start, strain_length: Runs of consecutive matched particles in a grid row.
-        sparse_particles: The other particles, and ``sparse_rows`` their subcell rows.
+        template: The rows every matched particle has (``Template``), entries by column, index
+            shifts over the positions.
+        strain_start, strain_point, strain_length: Runs of consecutive matched particles in a
+            grid row: first position, first point, length.
+        sparse_particles: The other points, and ``sparse_rows`` their subcell rows.
         force_shift, force_slot, force_grad: The template's entries in the order in which a
             node's transposed row meets them (shift descending, slot ascending).
-        force_start, force_length: Runs of nodes whose transposed rows are the template's alone.
+        force_start, force_node, force_length: Runs of nodes whose transposed rows are the
+            template's alone: first position, first node, length.
         sparse_nodes: The other nodes (their sparse transposed product), and
-            ``load_particles`` the particles whose subcell rows they read.
+            ``load_particles`` the points whose rows are read as rows (by the sparse nodes, or
+            by other ranks).
+        positions: The number of positions.
+        node_position: Position of each node of the coefficients (-1: outside the box), or
+            ``None`` (position = node).
+        ghost_rows, ghost_slot, ghost_position: The ghost rows of matched particles, their
+            slots and their particles' positions (a share's only).
     """
 
     template: Template
     strain_start: np.ndarray
+    strain_point: np.ndarray
     strain_length: np.ndarray
     sparse_particles: np.ndarray
     sparse_rows: np.ndarray
@@ -231,9 +261,15 @@ class LatticeStencil:
     force_slot: np.ndarray
     force_grad: np.ndarray
     force_start: np.ndarray
+    force_node: np.ndarray
     force_length: np.ndarray
     sparse_nodes: np.ndarray
     load_particles: np.ndarray
+    positions: int
+    node_position: np.ndarray | None = None
+    ghost_rows: np.ndarray | None = None
+    ghost_slot: np.ndarray | None = None
+    ghost_position: np.ndarray | None = None
 
     @property
     def coverage(self) -> tuple[float, float]:
@@ -250,52 +286,70 @@ class LatticeStencil:
         n = len(ptr) - 1
         cell = np.empty((n, 3))
         sub = np.empty((rows.num_rows, 3))
-        ux, uy = np.ascontiguousarray(d[0::2]), np.ascontiguousarray(d[1::2])
+        if self.node_position is None:
+            ux, uy = np.ascontiguousarray(d[0::2]), np.ascontiguousarray(d[1::2])
+        else:
+            ux, uy = np.empty(self.positions), np.empty(self.positions)  # read at the nodes' positions only
+            _scatter(d, self.node_position, ux, uy)
         t = self.template
-        _stencil_strains(ux, uy, ptr, fraction, self.strain_start, self.strain_length, t.ptr, t.shift, t.grad,
-                         cell, sub)
+        _stencil_strains(ux, uy, ptr, fraction, self.strain_start, self.strain_point, self.strain_length, t.ptr,
+                         t.shift, t.grad, cell, sub)
         _sparse_strains(rows.indptr, rows.indices, rows.data, d, ptr, fraction, self.sparse_rows,
                         self.sparse_particles, cell, sub)
         return cell, sub
+
+    def loads(self, ptr: np.ndarray, fraction: np.ndarray, weight: np.ndarray, volume: np.ndarray,
+              stress: np.ndarray, sub_stress: np.ndarray, load: np.ndarray) -> np.ndarray:
+        """The subcell loads of ``subcell_load`` (``sub_stress`` empty: none): slot major by
+        position for the runs (returned), and as rows into ``load`` for ``load_particles``."""
+        with_sub = sub_stress.shape[0] > 0
+        slot_major = np.empty((self.template.slots, 3, self.positions))
+        _stencil_loads(ptr, fraction, weight, volume, stress, sub_stress, with_sub, self.strain_start,
+                       self.strain_point, self.strain_length, slot_major)
+        _particle_loads(ptr, fraction, weight, volume, stress, sub_stress, with_sub, self.load_particles, load)
+        return slot_major
+
+    def damaged_loads(self, ptr: np.ndarray, fraction: np.ndarray, weight: np.ndarray, volume: np.ndarray,
+                      stress: np.ndarray, differences: np.ndarray, c: np.ndarray, damage: np.ndarray,
+                      load: np.ndarray) -> np.ndarray:
+        """``loads`` with the subcell stresses (1 - D_L) C ``differences``, formed as the loads
+        are (``rkfx.assembly.smeared_strain.damaged_subcell_stress``: the same numbers);
+        ``differences`` is overwritten."""
+        slot_major = np.empty((self.template.slots, 3, self.positions))
+        _stencil_damaged_loads(ptr, fraction, weight, volume, stress, differences, c, damage, self.strain_start,
+                               self.strain_point, self.strain_length, slot_major)
+        _particle_damaged_loads(ptr, fraction, weight, volume, stress, differences, c, damage, self.load_particles,
+                                load)
+        return slot_major
+
+    def transposed(self, slot_major: np.ndarray, load: np.ndarray, rows_t: SparseRows, unit: np.ndarray,
+                   out: np.ndarray) -> np.ndarray:
+        """The interleaved force of the loads into ``out``: by stencil from ``slot_major`` (the
+        ghost rows' loads placed there first), over the sparse nodes' transposed rows from
+        ``load``, in subcell order."""
+        if self.ghost_rows is not None and len(self.ghost_rows):
+            slot_major[self.ghost_slot, :, self.ghost_position] = load[self.ghost_rows]
+        _stencil_force(slot_major, self.force_start, self.force_node, self.force_length, self.force_shift,
+                       self.force_slot, self.force_grad, out)
+        _nodes_force(rows_t.indptr, rows_t.indices, rows_t.data, load, unit, self.sparse_nodes, out)
+        return out
 
     def force(self, rows_t: SparseRows, ptr: np.ndarray, fraction: np.ndarray, weight: np.ndarray,
               volume: np.ndarray, stress: np.ndarray, sub_stress: np.ndarray, unit: np.ndarray) -> np.ndarray:
         """The interleaved force of the nodal stresses and the subcell stresses (``sub_stress``
         empty: none) through the subcell loads, as ``subcell_load`` and the sparse transposed
         product over ``rows_t`` (row weights ``unit``, ones) give it, shape ``(2 n,)``."""
-        n = len(ptr) - 1
-        with_sub = sub_stress.shape[0] > 0
-        slot_major = np.empty((self.template.slots, 3, n))
-        _stencil_loads(ptr, fraction, weight, volume, stress, sub_stress, with_sub, self.strain_start,
-                       self.strain_length, slot_major)
         load = np.empty((len(fraction), 3))
-        _particle_loads(ptr, fraction, weight, volume, stress, sub_stress, with_sub, self.load_particles, load)
-        return self._transposed(slot_major, load, rows_t, unit)
+        slot_major = self.loads(ptr, fraction, weight, volume, stress, sub_stress, load)
+        return self.transposed(slot_major, load, rows_t, unit, np.empty(2 * (len(ptr) - 1)))
 
     def damaged_force(self, rows_t: SparseRows, ptr: np.ndarray, fraction: np.ndarray, weight: np.ndarray,
                       volume: np.ndarray, stress: np.ndarray, differences: np.ndarray, c: np.ndarray,
                       damage: np.ndarray, unit: np.ndarray) -> np.ndarray:
-        """``force`` with the subcell stresses (1 - D_L) C ``differences``, formed as the loads
-        are (``rkfx.assembly.smeared_strain.damaged_subcell_stress``: the same numbers);
-        ``differences`` is overwritten."""
-        n = len(ptr) - 1
-        slot_major = np.empty((self.template.slots, 3, n))
-        _stencil_damaged_loads(ptr, fraction, weight, volume, stress, differences, c, damage, self.strain_start,
-                               self.strain_length, slot_major)
+        """``force`` with the subcell stresses of ``damaged_loads``; ``differences`` is overwritten."""
         load = np.empty((len(fraction), 3))
-        _particle_damaged_loads(ptr, fraction, weight, volume, stress, differences, c, damage, self.load_particles,
-                                load)
-        return self._transposed(slot_major, load, rows_t, unit)
-
-    def _transposed(self, slot_major: np.ndarray, load: np.ndarray, rows_t: SparseRows,
-                    unit: np.ndarray) -> np.ndarray:
-        """The interleaved force of the loads: slot major by stencil, in subcell order over the
-        sparse nodes' transposed rows."""
-        out = np.empty(2 * slot_major.shape[2])
-        _stencil_force(slot_major, self.force_start, self.force_length, self.force_shift, self.force_slot,
-                       self.force_grad, out)
-        _nodes_force(rows_t.indptr, rows_t.indices, rows_t.data, load, unit, self.sparse_nodes, out)
-        return out
+        slot_major = self.damaged_loads(ptr, fraction, weight, volume, stress, differences, c, damage, load)
+        return self.transposed(slot_major, load, rows_t, unit, np.empty(2 * (len(ptr) - 1)))
 
 
 def lattice_stencil(rows: SparseRows, ptr: np.ndarray, matched: np.ndarray, template: Template,
@@ -307,8 +361,6 @@ def lattice_stencil(rows: SparseRows, ptr: np.ndarray, matched: np.ndarray, temp
     s_start, s_length = _runs(matched, lattice.nx)
     row_particle = np.repeat(np.arange(n), np.diff(ptr))
     sparse_rows = np.flatnonzero(~matched[row_particle]).astype(np.int64)
-    slot = np.repeat(np.arange(template.slots), np.diff(template.ptr))
-    order = np.lexsort((slot, -template.shift))
     counts = np.bincount(rows.indices, minlength=n)
     foreign = np.bincount(rows.indices[_entries(rows.indptr, sparse_rows)], minlength=n)
     alone = (counts == len(template.shift)) & (foreign == 0)
@@ -320,10 +372,84 @@ def lattice_stencil(rows: SparseRows, ptr: np.ndarray, matched: np.ndarray, temp
     reads = np.zeros(rows.num_rows, np.bool_)
     _rows_reading(rows.indptr, rows.indices, touched, reads)
     load_particles = np.unique(row_particle[reads]).astype(np.int64)
-    return LatticeStencil(template, s_start, s_length, np.flatnonzero(~matched).astype(np.int64), sparse_rows,
-                          np.ascontiguousarray(template.shift[order]), np.ascontiguousarray(slot[order]),
-                          np.ascontiguousarray(template.grad[order]), f_start, f_length, sparse_nodes,
-                          load_particles)
+    return _stencil(template, template.shift, s_start, s_start, s_length, np.flatnonzero(~matched), sparse_rows,
+                    f_start, f_start, f_length, sparse_nodes, load_particles, n)
+
+
+def share_stencil(snap: Snap, points: np.ndarray, rows: SparseRows, ptr: np.ndarray, nodes: np.ndarray,
+                  rows_t: SparseRows, row_particle: np.ndarray, row_slot: np.ndarray,
+                  sent_rows: np.ndarray) -> LatticeStencil:
+    """The stencils of a rank's share of a snapped operator (``rkfx.assembly.local_strain``),
+    over the box of grid positions its rows and their nodes span.
+
+    Args:
+        snap: The share's snapping (template, lattice, matched particles, global numbering).
+        points: Global index of the owned points (particles), ascending; their ``rows`` (over
+            the local nodes) by ``ptr``.
+        nodes: Global index of the local nodes, the owned ones (= ``points``) first; those
+            outside the box of the rows and their nodes (constraint columns) are left out.
+        rows_t: Each owned node's entries over the local rows (owned rows first).
+        row_particle, row_slot: Particle (global) and slot of each local row.
+        sent_rows: The owned rows other ranks read (their loads are needed as rows).
+    """
+    lat, template = snap.lattice, snap.template
+    owned = len(points)
+    gi, gj = lat.ij(np.concatenate([nodes[np.unique(rows.indices)], row_particle]))
+    i0, j0 = gi.min(), gj.min()
+    nxb, nyb = gi.max() - i0 + 1, gj.max() - j0 + 1
+    box = Lattice(int(nxb), int(nyb))
+
+    def position(index):
+        i, j = lat.ij(index)
+        return (j - j0) * nxb + (i - i0)
+
+    di, dj = lat.offsets(template.shift)
+    shift = dj * nxb + di
+    matched_row = snap.matched[row_particle]
+    mine = snap.matched[points]
+    at = position(points)
+    flags = np.zeros(box.nx * box.ny, np.bool_)
+    flags[at[mine]] = True
+    s_start, s_length = _runs(flags, box.nx)
+    point_at = np.full(len(flags), -1, np.int64)
+    point_at[at] = np.arange(owned)
+    owned_rows = ptr[-1]
+    sparse_rows = np.flatnonzero(~matched_row[:owned_rows]).astype(np.int64)
+    counts = np.diff(rows_t.indptr)
+    foreign = np.bincount(np.repeat(np.arange(len(counts)), counts), weights=~matched_row[rows_t.indices],
+                          minlength=len(counts))
+    alone = (counts == len(template.shift)) & (foreign == 0)
+    flags[:] = False
+    flags[at[alone]] = True
+    f_start, f_length = _runs(flags, box.nx)
+    sparse_nodes = np.flatnonzero(~alone).astype(np.int64)
+    read = rows_t.indices[_entries(rows_t.indptr, sparse_nodes)]
+    read = np.concatenate([read[read < owned_rows], np.asarray(sent_rows, np.int64)])
+    load_particles = np.unique(np.searchsorted(ptr, read, side="right") - 1).astype(np.int64)
+    ghosts = np.flatnonzero(matched_row[owned_rows:]) + owned_rows
+    position_of = np.where(_in_box(lat.ij(nodes), i0, j0, nxb, nyb), position(nodes), -1)
+    return _stencil(template, shift, s_start, point_at[s_start], s_length, np.flatnonzero(~mine), sparse_rows,
+                    f_start, point_at[f_start], f_length, sparse_nodes, load_particles, box.nx * box.ny,
+                    node_position=position_of.astype(np.int64), ghost_rows=ghosts.astype(np.int64),
+                    ghost_slot=np.asarray(row_slot[ghosts], np.int64),
+                    ghost_position=position(row_particle[ghosts]).astype(np.int64))
+
+
+def _in_box(ij, i0, j0, nx, ny) -> np.ndarray:
+    i, j = ij
+    return (i >= i0) & (i < i0 + nx) & (j >= j0) & (j < j0 + ny)
+
+
+def _stencil(template: Template, shift: np.ndarray, s_start, s_point, s_length, sparse_particles, sparse_rows,
+             f_start, f_node, f_length, sparse_nodes, load_particles, positions: int, **box) -> LatticeStencil:
+    """A ``LatticeStencil`` of the ``template`` with index ``shift`` over the positions."""
+    slot = np.repeat(np.arange(template.slots), np.diff(template.ptr))
+    order = np.lexsort((slot, -shift))
+    i64 = lambda a: np.ascontiguousarray(a, np.int64)  # noqa: E731
+    return LatticeStencil(Template(template.ptr, i64(shift), template.grad), i64(s_start), i64(s_point),
+                          i64(s_length), i64(sparse_particles), i64(sparse_rows), i64(shift[order]), i64(slot[order]),
+                          np.ascontiguousarray(template.grad[order]), i64(f_start), i64(f_node), i64(f_length),
+                          i64(sparse_nodes), i64(load_particles), int(positions), **box)
 
 
 @numba.njit(parallel=True, cache=True)
@@ -385,7 +511,7 @@ def _add_strain4(a0, a1, a2, u0, v0, u1, v1, u2, v2, u3, v3, g, t, m):
 
 
 @numba.njit(parallel=True, cache=True)
-def _stencil_strains(ux, uy, ptr, fraction, start, length, tptr, shift, grad, cell, sub):
+def _stencil_strains(ux, uy, ptr, fraction, start, point, length, tptr, shift, grad, cell, sub):
     """Subcell strains of the runs by the template, then their cell averages and differences."""
     slots = len(tptr) - 1
     for r in numba.prange(len(start)):
@@ -408,7 +534,7 @@ def _stencil_strains(ux, uy, ptr, fraction, start, length, tptr, shift, grad, ce
                 _add_strain(a0, a1, a2, ux[o:o + m], uy[o:o + m], grad[t, 0], grad[t, 1], m)
                 t += 1
         for x in range(m):  # particle_average, from the accumulators
-            ell = first + x
+            ell = point[r] + x
             p0 = ptr[ell]
             c0 = 0.0
             c1 = 0.0
@@ -436,30 +562,34 @@ def _sparse_strains(indptr, indices, grad, d, ptr, fraction, rows, particles, ce
 
 
 @numba.njit(parallel=True, cache=True)
-def _stencil_loads(ptr, fraction, weight, volume, stress, sub_stress, with_sub, start, length, out):
-    """particle_load of the runs' particles into out[s, :, L] (slot major)."""
+def _stencil_loads(ptr, fraction, weight, volume, stress, sub_stress, with_sub, start, point, length, out):
+    """particle_load of the runs' particles into out[s, :, position] (slot major)."""
     for r in numba.prange(len(start)):
-        for ell in range(start[r], start[r] + length[r]):
+        for x in range(length[r]):
+            ell = point[r] + x
+            at = start[r] + x
             t0, t1, t2 = particle_stress(ptr, weight, volume, stress, sub_stress, with_sub, ell)
             for s in range(out.shape[0]):
                 c = ptr[ell] + s
                 f = fraction[c]
-                out[s, 0, ell] = f * t0
-                out[s, 1, ell] = f * t1
-                out[s, 2, ell] = f * t2
+                out[s, 0, at] = f * t0
+                out[s, 1, at] = f * t1
+                out[s, 2, at] = f * t2
                 if with_sub:
-                    out[s, 0, ell] -= weight[c] * sub_stress[c, 0]
-                    out[s, 1, ell] -= weight[c] * sub_stress[c, 1]
-                    out[s, 2, ell] -= weight[c] * sub_stress[c, 2]
+                    out[s, 0, at] -= weight[c] * sub_stress[c, 0]
+                    out[s, 1, at] -= weight[c] * sub_stress[c, 1]
+                    out[s, 2, at] -= weight[c] * sub_stress[c, 2]
 
 
 @numba.njit(parallel=True, cache=True)
-def _stencil_damaged_loads(ptr, fraction, weight, volume, stress, diff, c, damage, start, length, out):
+def _stencil_damaged_loads(ptr, fraction, weight, volume, stress, diff, c, damage, start, point, length, out):
     """_stencil_loads with the subcell stresses (1 - D_L) C diff formed on the way."""
     slots = out.shape[0]
     for r in numba.prange(len(start)):
         sub = np.empty((slots, 3))
-        for ell in range(start[r], start[r] + length[r]):
+        for x in range(length[r]):
+            ell = point[r] + x
+            at = start[r] + x
             scale = 1.0 - damage[ell]
             p0 = ptr[ell]
             for s in range(slots):
@@ -477,9 +607,9 @@ def _stencil_damaged_loads(ptr, fraction, weight, volume, stress, diff, c, damag
             for s in range(slots):
                 f = fraction[p0 + s]
                 w = weight[p0 + s]
-                out[s, 0, ell] = f * t0 - w * sub[s, 0]
-                out[s, 1, ell] = f * t1 - w * sub[s, 1]
-                out[s, 2, ell] = f * t2 - w * sub[s, 2]
+                out[s, 0, at] = f * t0 - w * sub[s, 0]
+                out[s, 1, at] = f * t1 - w * sub[s, 1]
+                out[s, 2, at] = f * t2 - w * sub[s, 2]
 
 
 @numba.njit(parallel=True, cache=True)
@@ -509,7 +639,7 @@ def _add_force(fx, fy, t0, t1, t2, gx, gy, m):
 
 
 @numba.njit(parallel=True, cache=True)
-def _stencil_force(slot_major, start, length, shift, slot, grad, out):
+def _stencil_force(slot_major, start, node, length, shift, slot, grad, out):
     for r in numba.prange(len(start)):
         first = start[r]
         m = length[r]
@@ -523,8 +653,18 @@ def _stencil_force(slot_major, start, length, shift, slot, grad, out):
             _add_force(fx, fy, slot_major[s, 0, o:o + m], slot_major[s, 1, o:o + m], slot_major[s, 2, o:o + m],
                        grad[t, 0], grad[t, 1], m)
         for x in range(m):
-            out[2 * (first + x)] = fx[x]
-            out[2 * (first + x) + 1] = fy[x]
+            out[2 * (node[r] + x)] = fx[x]
+            out[2 * (node[r] + x) + 1] = fy[x]
+
+
+@numba.njit(cache=True)
+def _scatter(d, position, ux, uy):
+    """ux, uy at the positions of the nodes of interleaved d (nodes at -1 left out)."""
+    for k in range(len(position)):
+        at = position[k]
+        if at >= 0:
+            ux[at] = d[2 * k]
+            uy[at] = d[2 * k + 1]
 
 
 @numba.njit(parallel=True, cache=True)

@@ -23,7 +23,9 @@ any number of ranks. From a ``StrainRecipe`` a rank builds only the rows it read
 particles' rows, which become its local rows in place, and apart the rows of the other
 particles that touch its nodes (``StrainRecipe.near``); the transposed entries of its nodes
 are gathered from both in row order. No rank builds the whole operator or holds two copies
-of its rows.
+of its rows. On a uniform grid the rows of the share that are the template's run as lattice
+stencils over the share's box (``rkfx.assembly.lattice_stencil.share_stencil``), as the
+whole operator's do serially.
 """
 from dataclasses import dataclass
 
@@ -31,6 +33,7 @@ import numba
 import numpy as np
 
 from rkfx.approximation.sparse_rows import SparseRows, gathered_rows
+from rkfx.assembly.lattice_stencil import LatticeStencil, Snap, share_stencil
 from rkfx.assembly.smeared_strain import (SmearedStrain, StrainRecipe, cell_average, damaged_subcell_stress,
                                           row_strains, subcell_load, transposed_force)
 from rkfx.errors import InputError
@@ -67,6 +70,8 @@ class LocalSmearedStrain:
         node_halo, row_halo: The exchanges of ghost nodes and ghost rows.
         stabilization: The MSCNI terms' owners, or ``None`` (plain SCNI).
         node_of: Local index of every global node (-1 if not local), shape ``(n,)``.
+        stencil: The products as lattice stencils over the share's box of a uniform grid
+            (``rkfx.assembly.lattice_stencil.share_stencil``), or ``None``.
     """
 
     nodes: np.ndarray
@@ -84,6 +89,7 @@ class LocalSmearedStrain:
     row_halo: Halo
     stabilization: LocalStabilization | None
     node_of: np.ndarray
+    stencil: LatticeStencil | None = None
 
     @property
     def num_nodes(self) -> int:
@@ -121,6 +127,8 @@ class LocalSmearedStrain:
         """The smeared strains ``(num_owned, 3)`` and the MSCNI differences per owned row."""
         if self.stabilization is None:
             raise InputError("this operator has no MSCNI terms; build it with smeared_strain(..., eps_p=1)")
+        if self.stencil is not None:
+            return self.stencil.strains(self.rows, self.ptr, self.fraction, np.ascontiguousarray(d, np.float64))
         sub = row_strains(self.rows, d)
         return cell_average(self.ptr, self.fraction, sub), sub
 
@@ -130,11 +138,13 @@ class LocalSmearedStrain:
         stress = np.ascontiguousarray(stress, dtype=np.float64)
         load = np.empty((len(self.row_weight), 3))
         mine = load[:len(self.owned_rows)]  # the owned rows come first
+        sub = np.empty((0, 3)) if subcell_stress is None else np.ascontiguousarray(subcell_stress, dtype=np.float64)
+        if self.stencil is not None:
+            slot_major = self.stencil.loads(self.ptr, self.fraction, self.weight, self.volume, stress, sub, load)
+            return self._stencil_force(slot_major, load)
         if self.stabilization is None:
             mine[...] = stress
         else:
-            sub = np.empty((0, 3)) if subcell_stress is None else \
-                np.ascontiguousarray(subcell_stress, dtype=np.float64)
             subcell_load(self.ptr, self.fraction, self.weight, self.volume, stress, sub, mine)
         self.row_halo.exchange(load)
         f = np.empty(2 * self.num_local)
@@ -142,10 +152,25 @@ class LocalSmearedStrain:
         self.node_halo.exchange(f.reshape(-1, 2))
         return f
 
+    def _stencil_force(self, slot_major: np.ndarray, load: np.ndarray) -> np.ndarray:
+        """The force of the stencil's loads: the ghost rows' loads brought in, the stencils and
+        the sparse nodes' products, the ghost nodes' force brought in."""
+        self.row_halo.exchange(load)
+        f = np.empty(2 * self.num_local)
+        self.stencil.transposed(slot_major, load, self.rows_t, self.row_weight, f[:2 * len(self.owned_nodes)])
+        self.node_halo.exchange(f.reshape(-1, 2))
+        return f
+
     def damaged_force(self, stress: np.ndarray, differences: np.ndarray, c: np.ndarray,
                       damage: np.ndarray) -> np.ndarray:
         """``force`` with the damaged MSCNI subcell stresses of ``differences`` (as
         ``SmearedStrain.damaged_force``; damage per owned point). Collective."""
+        if self.stencil is not None:
+            load = np.empty((len(self.row_weight), 3))
+            slot_major = self.stencil.damaged_loads(self.ptr, self.fraction, self.weight, self.volume,
+                                                    np.ascontiguousarray(stress, dtype=np.float64), differences, c,
+                                                    damage, load)
+            return self._stencil_force(slot_major, load)
         damaged_subcell_stress(differences, c, self.stabilization.owner, damage, differences)
         return self.force(stress, differences)
 
@@ -167,6 +192,13 @@ def _numbering(owned: np.ndarray, others: np.ndarray, owner: np.ndarray, size: i
     local_of = np.full(size, -1, np.int64)
     local_of[order] = np.arange(len(order))
     return order, local_of
+
+
+@numba.njit(cache=True)
+def _renumber(index, new):
+    """index[k] = new[index[k]], in place."""
+    for k in range(len(index)):
+        index[k] = new[index[k]]
 
 
 @numba.njit(cache=True)
@@ -219,7 +251,7 @@ def _owned_columns(sources: list[SparseRows], mine: np.ndarray, n: int):
     fill = np.zeros(len(mine), np.int64)
     np.cumsum(counts[:-1], out=fill[1:])
     size = int(counts.sum())
-    out_rows, out_data = np.empty(size, np.int64), np.empty((size, *sources[0].data.shape[1:]))
+    out_rows, out_data = np.empty(size, np.int32), np.empty((size, *sources[0].data.shape[1:]))
     a = sources[0]
     b = sources[1] if len(sources) > 1 else SparseRows(np.zeros_like(a.indptr), a.indices[:0], a.data[:0], a.num_cols)
     _copy_columns(a.indptr, a.indices, a.data, b.indptr, b.indices, b.data, column, fill, out_rows, out_data)
@@ -258,14 +290,19 @@ def local_smeared_strain(op: SmearedStrain | StrainRecipe, part: np.ndarray, com
         raise InputError(f"particle parts have shape {part.shape}; expected ({n},)")
     mine = np.flatnonzero(part == comm.rank)
     spent = isinstance(op, StrainRecipe)  # rows built here for this rank alone
+    near_snap = None
     if spent:
-        others = _terms(op.build(np.setdiff1d(op.near(part, comm.rank), mine)))[0]
+        near = op.build(np.setdiff1d(op.near(part, comm.rank), mine))
+        others, near_snap = _terms(near)[0], _snap(near)
+        del near
         op = op.build(mine)
         sources = [_terms(op)[0], others]
         del others
     else:
         sources = None
     rows, ptr, row_point, s = _terms(op)
+    snap, volume = _snap(op), op.volume
+    del op  # a build of this rank's alone: its cell rows go (the force reads the subcell rows)
     counts = ptr[mine + 1] - ptr[mine]
     orows = _ranges(ptr[mine], counts)
     touched = np.zeros(n, bool)
@@ -277,21 +314,37 @@ def local_smeared_strain(op: SmearedStrain | StrainRecipe, part: np.ndarray, com
     del sources
     local_rows = _renumbered_rows(rows, orows, node_of, len(nodes)) if spent else \
         gathered_rows(rows, orows, node_of, len(nodes))
-    lrows, row_of = _numbering(orows, trows, part[row_point], rows.num_rows)
+    read = np.zeros(rows.num_rows, np.bool_)
+    read[trows] = True
+    lrows, row_of = _numbering(orows, np.flatnonzero(read), part[row_point], rows.num_rows)
+    del read
     t_indptr = np.zeros(len(mine) + 1, np.int64)
     np.cumsum(t_counts, out=t_indptr[1:])
-    local_t = SparseRows(t_indptr, row_of[trows].astype(np.int32), t_data, len(lrows))
-    row_weight = np.ones(len(lrows)) if s is not None else np.ascontiguousarray(op.volume[row_point[lrows]])
+    _renumber(trows, row_of)
+    local_t = SparseRows(t_indptr, trows, t_data, len(lrows))
+    row_weight = np.ones(len(lrows)) if s is not None else np.ascontiguousarray(volume[row_point[lrows]])
     point_ptr = np.zeros(len(mine) + 1, np.int64)
     np.cumsum(counts, out=point_ptr[1:])
     stab = None if s is None else LocalStabilization(np.repeat(np.arange(len(mine)), counts))
+    row_halo = halo(_row_names(lrows, ptr, row_point, comm), part[row_point[lrows]], comm)
+    stencil = None
+    if snap is not None and len(mine):
+        if near_snap is not None:
+            snap = Snap(snap.template, snap.lattice, snap.matched | near_snap.matched)
+        particle = row_point[lrows]
+        stencil = share_stencil(snap, mine, local_rows, point_ptr, nodes, local_t, particle, lrows - ptr[particle],
+                                np.concatenate([np.zeros(0, np.int64), *row_halo.send]))
     return LocalSmearedStrain(
         nodes, np.arange(len(mine)), mine, local_rows, point_ptr,
         None if s is None else np.ascontiguousarray(s.fraction[orows]),
         None if s is None else np.ascontiguousarray(s.weight[orows]),
-        np.ascontiguousarray(op.volume[mine]), local_t, row_weight, np.arange(len(orows)),
-        halo(nodes, part[nodes], comm), halo(_row_names(lrows, ptr, row_point, comm), part[row_point[lrows]], comm),
-        stab, node_of)
+        np.ascontiguousarray(volume[mine]), local_t, row_weight, np.arange(len(orows)),
+        halo(nodes, part[nodes], comm), row_halo, stab, node_of, stencil)
+
+
+def _snap(op: SmearedStrain) -> Snap | None:
+    """The snapping of an MSCNI build's rows (``rkfx.assembly.lattice_stencil``), if any."""
+    return None if op.stabilization is None else op.stabilization.snap
 
 
 def _row_names(rows: np.ndarray, ptr: np.ndarray, row_point: np.ndarray, comm) -> np.ndarray:

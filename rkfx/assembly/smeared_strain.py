@@ -34,7 +34,7 @@ from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.errors import InputError
 from rkfx.geometry.nodal_domains import NodalDomains, nodal_domains
 from rkfx.assembly.operators import strain_matrix
-from rkfx.assembly.lattice_stencil import (LatticeStencil, lattice_of, lattice_stencil, snap_to_template,
+from rkfx.assembly.lattice_stencil import (LatticeStencil, Snap, lattice_of, lattice_stencil, snap_to_template,
                                            sort_rows, template_particle, template_rows)
 from rkfx.assembly.row_products import damaged_stress, node_force, particle_average, particle_load, row_strain
 from rkfx.geometry.particles import Particles
@@ -134,6 +134,8 @@ class Stabilization:
         weight: eps_p A_C, shape ``(num_subcells,)`` [m^2].
         stencil: The products as lattice stencils where the rows are a uniform grid's
             template (``rkfx.assembly.lattice_stencil``), or ``None``.
+        snap: The template the rows were snapped to and the particles that have it (a rank's
+            share builds its stencils from it, ``rkfx.assembly.local_strain``), or ``None``.
     """
 
     rows: SparseRows
@@ -142,6 +144,7 @@ class Stabilization:
     fraction: np.ndarray
     weight: np.ndarray
     stencil: LatticeStencil | None = None
+    snap: Snap | None = None
 
     @cached_property
     def rows_t(self) -> SparseRows:
@@ -311,9 +314,11 @@ def smeared_strain(p: Particles, rk: RKApproximation, domains: NodalDomains | No
     ptr = np.zeros(p.num_nodes + 1, np.int64)
     np.cumsum(np.bincount(owner, minlength=p.num_nodes), out=ptr[1:])
     area = domains.subcell_area[order]
-    stencil = _snapped_stencil(p, rk, domains, sub, ptr, points) if lattice else None
+    snap = _snapped(p, rk, domains, sub, ptr, points) if lattice else None
+    stencil = None if snap is None or points is not None else \
+        lattice_stencil(sub, ptr, snap.matched, snap.template, snap.lattice)
     stab = Stabilization(sub, ptr, owner, np.ascontiguousarray(area / volume[owner]),
-                         np.ascontiguousarray(eps_p * area, dtype=np.float64), stencil)
+                         np.ascontiguousarray(eps_p * area, dtype=np.float64), stencil, snap)
     op = SmearedStrain(cell, volume, stab)
     probe = np.random.default_rng(0).standard_normal(2 * p.num_nodes)
     direct = row_strains(cell, probe)
@@ -326,12 +331,11 @@ def smeared_strain(p: Particles, rk: RKApproximation, domains: NodalDomains | No
     return op
 
 
-def _snapped_stencil(p: Particles, rk: RKApproximation, domains: NodalDomains, sub: SparseRows, ptr: np.ndarray,
-                     points: np.ndarray | None) -> LatticeStencil | None:
+def _snapped(p: Particles, rk: RKApproximation, domains: NodalDomains, sub: SparseRows, ptr: np.ndarray,
+             points: np.ndarray | None) -> Snap | None:
     """Snap the subcell rows ``sub`` of a uniform grid to the template particle's
-    (``rkfx.assembly.lattice_stencil``) and, if they are the whole operator's, return their
-    stencils; ``None`` (rows untouched) off a grid, without a template particle, or when these
-    domains hold no cell of it."""
+    (``rkfx.assembly.lattice_stencil``); ``None`` (rows untouched) off a grid, without a
+    template particle, or when these domains hold no cell of it."""
     lat = lattice_of(p.x)
     c = None if lat is None else template_particle(p.x, rk)
     if c is None:
@@ -345,10 +349,7 @@ def _snapped_stencil(p: Particles, rk: RKApproximation, domains: NodalDomains, s
         return None
     sort_rows(sub)
     template = template_rows(source, ptr, c)
-    matched = snap_to_template(sub, ptr, template, lat)
-    if points is not None:
-        return None
-    return lattice_stencil(sub, ptr, matched, template, lat)
+    return Snap(template, lat, snap_to_template(sub, ptr, template, lat))
 
 
 @dataclass(frozen=True)

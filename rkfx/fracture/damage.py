@@ -41,6 +41,7 @@ Out-of-plane strain in Mazars' norm: plane strain has eps_zz = 0, which adds not
 plane stress has eps_zz = -nu / (1 - nu) (eps_xx + eps_yy), which counts when positive.
 """
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -244,6 +245,20 @@ class CellGeometry:
     vertices: np.ndarray
     num_nodes: int
 
+    @cached_property
+    def by_node(self) -> tuple[np.ndarray, np.ndarray]:
+        """The subcells grouped by node: node L has the subcells ``order[ptr[L]:ptr[L + 1]]``."""
+        ptr = np.zeros(self.num_nodes + 1, np.int64)
+        np.cumsum(np.bincount(self.node, minlength=self.num_nodes), out=ptr[1:])
+        return np.argsort(self.node, kind="stable"), ptr
+
+    def subcells(self, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The subcells of ``nodes`` and the place in ``nodes`` of each subcell's node."""
+        order, ptr = self.by_node
+        first, count = ptr[nodes], ptr[nodes + 1] - ptr[nodes]
+        where = np.repeat(np.arange(len(nodes)), count)
+        return order[np.arange(count.sum()) + np.repeat(first - (np.cumsum(count) - count), count)], where
+
 
 def cell_geometry(p: Particles | NodalDomains) -> CellGeometry:
     """Subcell quadrilaterals of the nodal domains.
@@ -310,10 +325,7 @@ def chord_lengths(geometry: CellGeometry, nodes: np.ndarray, normals: np.ndarray
     """
     nodes = np.asarray(nodes, np.int64).reshape(-1)
     n = np.asarray(normals, float).reshape(-1, 2)
-    slot = np.full(geometry.num_nodes, -1, np.int64)
-    slot[nodes] = np.arange(len(nodes))
-    sub = np.flatnonzero(slot[geometry.node] >= 0)
-    where = slot[geometry.node[sub]]
+    sub, where = geometry.subcells(nodes)
     t = np.column_stack([-n[:, 1], n[:, 0]])[where]
     total = np.zeros(len(nodes))
     for sign in (1.0, -1.0):
