@@ -11,6 +11,7 @@ import warnings
 from collections.abc import Mapping
 
 import dolfinx_solver  # noqa: F401  (orders MPI before petsc4py)
+import numba
 import numpy as np
 import scipy.sparse as sp
 from mpi4py import MPI
@@ -75,16 +76,26 @@ def owned_rows_mat(block: sp.spmatrix, comm=MPI.COMM_WORLD) -> PETSc.Mat:
     mat.setSizes(((m, n), (m, n)))
     mat.setType(PETSc.Mat.Type.AIJ)
     lo = (comm.exscan(m) or 0) if comm.size > 1 else 0  # the block's first global row
-    inside = (block.indices >= lo) & (block.indices < lo + m)
-    row = np.repeat(np.arange(m), np.diff(block.indptr))
-    d_nnz = np.bincount(row[inside], minlength=m).astype(PETSc.IntType)
+    d_nnz = np.empty(m, PETSc.IntType)
+    _columns_within(block.indptr, block.indices, lo, lo + m, d_nnz)
     o_nnz = (np.diff(block.indptr) - d_nnz).astype(PETSc.IntType)
     mat.setPreallocationNNZ((d_nnz, o_nnz))
     mat.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
-    mat.setValuesCSR(block.indptr.astype(PETSc.IntType), block.indices.astype(PETSc.IntType),
-                     block.data.astype(PETSc.ScalarType))
+    mat.setValuesCSR(block.indptr.astype(PETSc.IntType), block.indices.astype(PETSc.IntType, copy=False),
+                     block.data.astype(PETSc.ScalarType, copy=False))
     mat.assemble()
     return mat
+
+
+@numba.njit(cache=True)
+def _columns_within(indptr, indices, lo, hi, out):
+    """out[row] = the number of the row's columns in lo..hi-1."""
+    for row in range(len(indptr) - 1):
+        count = 0
+        for q in range(indptr[row], indptr[row + 1]):
+            if lo <= indices[q] < hi:
+                count += 1
+        out[row] = count
 
 
 def _sorted_csr(a: sp.spmatrix) -> sp.csr_matrix:

@@ -7,6 +7,7 @@ which is what a row-distributed PETSc matrix needs (``rkfx.linalg.petsc.LinearSo
 ``owned_rows=True``). ``comm`` is any mpi4py-style communicator (``rank``, ``size``,
 ``alltoall``) or ``None``; this module does not import MPI.
 """
+import numba
 import numpy as np
 import scipy.sparse as sp
 
@@ -25,7 +26,9 @@ def owned_block(a: sp.spmatrix, ranges: np.ndarray, comm=None) -> sp.csr_matrix:
     a = sp.csr_matrix(a)
     rank, size = (0, 1) if comm is None else (comm.rank, comm.size)
     lo, hi = int(ranges[rank]), int(ranges[rank + 1])
-    mine = a[lo:hi]
+    first, last = a.indptr[lo], a.indptr[hi]  # the block's rows as views (scipy's slice checks every column)
+    mine = sp.csr_matrix((a.data[first:last], a.indices[first:last], a.indptr[lo:hi + 1] - first),
+                         shape=(hi - lo, a.shape[1]))
     if size > 1:
         filled = np.flatnonzero(np.diff(a.indptr))
         owner = np.searchsorted(ranges, filled, side="right") - 1
@@ -39,8 +42,11 @@ def owned_block(a: sp.spmatrix, ranges: np.ndarray, comm=None) -> sp.csr_matrix:
                 got = sp.csr_matrix((data, indices, indptr), shape=(len(rows), a.shape[1])).tocoo()
                 mine = mine + sp.csr_matrix((got.data, (rows[got.row], got.col)), shape=mine.shape)
     mine = sp.csr_matrix(mine)
-    mine.sum_duplicates()
-    mine.sort_indices()
+    if not mine.has_canonical_format:
+        if np.shares_memory(mine.data, a.data):
+            mine = mine.copy()  # a's own arrays stay as they are
+        mine.sum_duplicates()
+        mine.sort_indices()
     return mine
 
 
@@ -54,19 +60,14 @@ def renumbered(a: sp.spmatrix, new: np.ndarray, size: int) -> sp.csr_matrix:
     """
     a = sp.csr_matrix(a)
     new = np.asarray(new, np.int64)
-    source = np.full(size, -1, np.int64)
-    source[new] = np.arange(len(new))
     lengths = np.zeros(size, np.int64)
-    filled = source >= 0
-    lengths[filled] = np.diff(a.indptr)[source[filled]]
-    indptr = np.zeros(size + 1, np.int64)
+    lengths[new] = np.diff(a.indptr)
+    index = np.int32 if max(size, a.nnz) <= np.iinfo(np.int32).max else np.int64  # as scipy would pick
+    indptr = np.zeros(size + 1, index)
     np.cumsum(lengths, out=indptr[1:])
-    rows = np.flatnonzero(lengths)
-    # Entry e of the result comes from entry at[e] of a: one gather, no COO round trip.
-    at = np.repeat(a.indptr[source[rows]] - indptr[rows], lengths[rows]) + np.arange(indptr[-1])
-    out = sp.csr_matrix((a.data[at], new[a.indices[at]], indptr), shape=(size, size))
-    out.sort_indices()
-    return out
+    indices, data = np.empty(indptr[-1], index), np.empty(indptr[-1], a.dtype)
+    _moved(a.indptr, a.indices, a.data, new, indptr, indices, data)  # each row's columns sorted there
+    return sp.csr_matrix((data, indices, indptr), shape=(size, size))
 
 
 def owned_entries(v: np.ndarray, ranges: np.ndarray, comm=None) -> np.ndarray:
@@ -75,3 +76,21 @@ def owned_entries(v: np.ndarray, ranges: np.ndarray, comm=None) -> np.ndarray:
     v = np.asarray(v, dtype=np.float64)
     column = sp.csr_matrix(v.reshape(-1, 1))
     return owned_block(column, ranges, comm).toarray().ravel()
+
+
+@numba.njit(parallel=True, cache=True)
+def _moved(indptr, indices, data, new, out_ptr, out_idx, out_data):
+    """Row i of (indptr, indices, data) to row new[i] at out_ptr, its columns j to new[j],
+    sorted by the new column (insertion sort, stable: a row's columns come sorted but for the
+    few that the new numbering moves past others)."""
+    for i in numba.prange(len(indptr) - 1):
+        at = out_ptr[new[i]]
+        for q in range(indptr[i], indptr[i + 1]):
+            c, v = new[indices[q]], data[q]
+            p = at + q - indptr[i] - 1
+            while p >= at and out_idx[p] > c:
+                out_idx[p + 1] = out_idx[p]
+                out_data[p + 1] = out_data[p]
+                p -= 1
+            out_idx[p + 1] = c
+            out_data[p + 1] = v
