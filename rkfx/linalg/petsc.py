@@ -163,6 +163,7 @@ def make_ksp(mat: PETSc.Mat, solver: str = "mumps", rtol: float | None = None, p
         # Saddle-point systems (multiplier constraints, u-p coupling) delay pivots: give MUMPS
         # room for them (ICNTL(14): % extra workspace) instead of failing with INFOG(1) = -9.
         factor = pc.getFactorMatrix()
+        factor.setOptionsPrefix(prefix)  # -<prefix>mat_mumps_icntl_<i> and _cntl_<i> reach MUMPS
         factor.setMumpsIcntl(14, 200)
         # Detect null pivots so that a singular system is reported, not "solved".
         factor.setMumpsIcntl(24, 1)
