@@ -140,24 +140,25 @@ class LocalSmearedStrain:
         mine = load[:len(self.owned_rows)]  # the owned rows come first
         sub = np.empty((0, 3)) if subcell_stress is None else np.ascontiguousarray(subcell_stress, dtype=np.float64)
         if self.stencil is not None:
-            slot_major = self.stencil.loads(self.ptr, self.fraction, self.weight, self.volume, stress, sub, load)
-            return self._stencil_force(slot_major, load)
+            return self._stencil_force(self.stencil.loads(self.ptr, self.fraction, self.weight, self.volume, stress,
+                                                          sub, load), load)
         if self.stabilization is None:
             mine[...] = stress
         else:
             subcell_load(self.ptr, self.fraction, self.weight, self.volume, stress, sub, mine)
-        self.row_halo.exchange(load)
-        f = np.empty(2 * self.num_local)
-        transposed_force(self.rows_t, load, self.row_weight, out=f[:2 * len(self.owned_nodes)])
-        self.node_halo.exchange(f.reshape(-1, 2))
-        return f
+        return self._exchanged(load, lambda out: transposed_force(self.rows_t, load, self.row_weight, out=out))
 
     def _stencil_force(self, slot_major: np.ndarray, load: np.ndarray) -> np.ndarray:
-        """The force of the stencil's loads: the ghost rows' loads brought in, the stencils and
-        the sparse nodes' products, the ghost nodes' force brought in."""
+        """The force of the stencil's loads (slot major, and as rows in ``load``)."""
+        return self._exchanged(load, lambda out: self.stencil.transposed(slot_major, load, self.rows_t,
+                                                                         self.row_weight, out))
+
+    def _exchanged(self, load: np.ndarray, transposed) -> np.ndarray:
+        """The local force from the owned rows' ``load``: the ghost rows' loads brought in,
+        ``transposed(out)`` writing the owned nodes' force, the ghost nodes' force brought in."""
         self.row_halo.exchange(load)
         f = np.empty(2 * self.num_local)
-        self.stencil.transposed(slot_major, load, self.rows_t, self.row_weight, f[:2 * len(self.owned_nodes)])
+        transposed(f[:2 * len(self.owned_nodes)])
         self.node_halo.exchange(f.reshape(-1, 2))
         return f
 
@@ -167,10 +168,9 @@ class LocalSmearedStrain:
         ``SmearedStrain.damaged_force``; damage per owned point). Collective."""
         if self.stencil is not None:
             load = np.empty((len(self.row_weight), 3))
-            slot_major = self.stencil.damaged_loads(self.ptr, self.fraction, self.weight, self.volume,
-                                                    np.ascontiguousarray(stress, dtype=np.float64), differences, c,
-                                                    damage, load)
-            return self._stencil_force(slot_major, load)
+            return self._stencil_force(self.stencil.damaged_loads(self.ptr, self.fraction, self.weight, self.volume,
+                                                                  np.ascontiguousarray(stress, dtype=np.float64),
+                                                                  differences, c, damage, load), load)
         damaged_subcell_stress(differences, c, self.stabilization.owner, damage, differences)
         return self.force(stress, differences)
 
