@@ -11,6 +11,10 @@ import numba
 import numpy as np
 import scipy.sparse as sp
 
+# Above this share of rows whose columns the new numbering leaves unsorted, ``renumbered``
+# sorts every row by scipy's sort (blocks of unknowns interleaved); below it, only those rows.
+UNSORTED_SHARE = 0.05
+
 
 def owned_block(a: sp.spmatrix, ranges: np.ndarray, comm=None) -> sp.csr_matrix:
     """The rows ``ranges[rank]:ranges[rank + 1]`` of the sum over ranks of ``a``.
@@ -66,8 +70,17 @@ def renumbered(a: sp.spmatrix, new: np.ndarray, size: int) -> sp.csr_matrix:
     indptr = np.zeros(size + 1, index)
     np.cumsum(lengths, out=indptr[1:])
     indices, data = np.empty(indptr[-1], index), np.empty(indptr[-1], a.dtype)
-    _moved(a.indptr, a.indices, a.data, new, indptr, indices, data)  # each row's columns sorted there
-    return sp.csr_matrix((data, indices, indptr), shape=(size, size))
+    unsorted = np.zeros(size, np.bool_)
+    _moved(a.indptr, a.indices, a.data, new, indptr, indices, data, unsorted)
+    out = sp.csr_matrix((data, indices, indptr), shape=(size, size))
+    rows = np.flatnonzero(unsorted)
+    if len(rows) > UNSORTED_SHARE * len(new):  # rows of interleaved blocks (u and p): scipy sorts them all
+        out.has_sorted_indices = False
+        out.sort_indices()
+    else:  # a few rows where the new numbering moves columns past others (a partition's cut)
+        _insertion_sorted(indptr, indices, data, rows)
+        out.has_sorted_indices = True
+    return out
 
 
 def owned_entries(v: np.ndarray, ranges: np.ndarray, comm=None) -> np.ndarray:
@@ -79,18 +92,32 @@ def owned_entries(v: np.ndarray, ranges: np.ndarray, comm=None) -> np.ndarray:
 
 
 @numba.njit(parallel=True, cache=True)
-def _moved(indptr, indices, data, new, out_ptr, out_idx, out_data):
-    """Row i of (indptr, indices, data) to row new[i] at out_ptr, its columns j to new[j],
-    sorted by the new column (insertion sort, stable: a row's columns come sorted but for the
-    few that the new numbering moves past others)."""
+def _moved(indptr, indices, data, new, out_ptr, out_idx, out_data, unsorted):
+    """Row i of (indptr, indices, data) to row new[i] at out_ptr, its columns j to new[j] in
+    their order; ``unsorted[new[i]]`` tells whether they are no longer ascending."""
     for i in numba.prange(len(indptr) - 1):
-        at = out_ptr[new[i]]
+        at = out_ptr[new[i]] - indptr[i]
+        last = -1
         for q in range(indptr[i], indptr[i + 1]):
-            c, v = new[indices[q]], data[q]
-            p = at + q - indptr[i] - 1
-            while p >= at and out_idx[p] > c:
-                out_idx[p + 1] = out_idx[p]
-                out_data[p + 1] = out_data[p]
+            c = new[indices[q]]
+            out_idx[at + q] = c
+            out_data[at + q] = data[q]
+            if c < last:
+                unsorted[new[i]] = True
+            last = c
+
+
+@numba.njit(parallel=True, cache=True)
+def _insertion_sorted(ptr, idx, data, rows):
+    """Sort the entries of ``rows`` by column, in place (stable)."""
+    for k in numba.prange(len(rows)):
+        r = rows[k]
+        for q in range(ptr[r] + 1, ptr[r + 1]):
+            c, v = idx[q], data[q]
+            p = q - 1
+            while p >= ptr[r] and idx[p] > c:
+                idx[p + 1] = idx[p]
+                data[p + 1] = data[p]
                 p -= 1
-            out_idx[p + 1] = c
-            out_data[p + 1] = v
+            idx[p + 1] = c
+            data[p + 1] = v
