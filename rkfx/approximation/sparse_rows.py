@@ -231,6 +231,37 @@ def gathered_rows(rows: SparseRows, which: np.ndarray, column: np.ndarray | None
     return SparseRows(out_ptr, out_idx, out_data, rows.num_cols if num_cols is None else num_cols)
 
 
+@numba.njit(parallel=True, cache=True)
+def _sort_by_column(indptr, indices, data, rows):
+    for k in numba.prange(len(rows)):  # insertion sort, stable: rows are short or nearly sorted
+        r = rows[k]
+        held = np.empty(data.shape[1], data.dtype)
+        for q in range(indptr[r] + 1, indptr[r + 1]):
+            i = indices[q]
+            held[:] = data[q]
+            p = q - 1
+            while p >= indptr[r] and indices[p] > i:
+                indices[p + 1] = indices[p]
+                data[p + 1] = data[p]
+                p -= 1
+            indices[p + 1] = i
+            data[p + 1] = held
+
+
+def sort_by_column(indptr: np.ndarray, indices: np.ndarray, data: np.ndarray, rows: np.ndarray | None = None) -> None:
+    """Order the entries of ``rows`` (default all) of CSR-like arrays by column, in place and
+    stably; ``data`` has one value per entry, or a row of values ``(nnz, k)``."""
+    rows = np.arange(len(indptr) - 1) if rows is None else np.asarray(rows, np.int64)
+    _sort_by_column(indptr, indices, data.reshape(len(data), -1), rows)
+
+
+def ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """The concatenation of ``arange(s, s + c)`` over ``zip(starts, counts)`` (e.g. the entry
+    positions of some rows: their ``indptr`` starts and lengths), int64."""
+    starts, counts = np.asarray(starts, np.int64), np.asarray(counts, np.int64)
+    return np.arange(counts.sum()) + np.repeat(starts - (np.cumsum(counts) - counts), counts)
+
+
 def spread_rows(rows: SparseRows, at: np.ndarray, num_rows: int) -> SparseRows:
     """``rows`` placed as the rows ``at`` (ascending) of ``num_rows`` rows, the others empty
     (the same entry arrays)."""

@@ -35,7 +35,7 @@ import numba
 import numpy as np
 
 from rkfx.approximation.shape_functions import RKApproximation
-from rkfx.approximation.sparse_rows import SparseRows
+from rkfx.approximation.sparse_rows import SparseRows, ranges, sort_by_column
 from rkfx.assembly.row_products import (damaged_stress, node_force, particle_average, particle_load, particle_stress,
                                         row_strain)
 
@@ -135,26 +135,10 @@ class Snap:
     matched: np.ndarray
 
 
-@numba.njit(parallel=True, cache=True)
-def _sort_rows(indptr, indices, data):
-    for row in numba.prange(len(indptr) - 1):
-        for q in range(indptr[row] + 1, indptr[row + 1]):  # insertion sort: rows are short
-            i, g0, g1 = indices[q], data[q, 0], data[q, 1]
-            p = q - 1
-            while p >= indptr[row] and indices[p] > i:
-                indices[p + 1] = indices[p]
-                data[p + 1, 0] = data[p, 0]
-                data[p + 1, 1] = data[p, 1]
-                p -= 1
-            indices[p + 1] = i
-            data[p + 1, 0] = g0
-            data[p + 1, 1] = g1
-
-
 def sort_rows(rows: SparseRows) -> None:
     """Order the entries of every row by column, in place (so that equal rows of shifted
     particles list their entries in the same order)."""
-    _sort_rows(rows.indptr, rows.indices, rows.data)
+    sort_by_column(rows.indptr, rows.indices, rows.data)
 
 
 def template_rows(rows: SparseRows, ptr: np.ndarray, particle: int) -> Template:
@@ -464,9 +448,7 @@ def _rows_reading(indptr, indices, nodes, out):
 
 def _entries(indptr: np.ndarray, rows: np.ndarray) -> np.ndarray:
     """The entry positions of ``rows``."""
-    first = indptr[rows]
-    size = indptr[rows + 1] - first
-    return np.arange(size.sum()) + np.repeat(first - (np.cumsum(size) - size), size)
+    return ranges(indptr[rows], indptr[rows + 1] - indptr[rows])
 
 
 # --------------------------------------------------------------------------- kernels

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from rkfx.approximation.sparse_rows import SparseRows, gathered_rows
+from rkfx.approximation.sparse_rows import SparseRows, gathered_rows, ranges
 from rkfx.assembly.lattice_stencil import LatticeStencil, Snap, share_stencil
 from rkfx.assembly.smeared_strain import (SmearedStrain, StrainRecipe, cell_average, damaged_subcell_stress,
                                           row_strains, subcell_load, transposed_force)
@@ -175,13 +175,6 @@ class LocalSmearedStrain:
         return self.force(stress, differences)
 
 
-def _ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
-    """The concatenation of ``arange(s, s + c)`` over ``zip(starts, counts)``."""
-    total = int(counts.sum())
-    offsets = np.repeat(starts - np.concatenate([[0], np.cumsum(counts)[:-1]]), counts)
-    return offsets + np.arange(total)
-
-
 def _numbering(owned: np.ndarray, others: np.ndarray, owner: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
     """Local order of global entries: ``owned`` first (ascending), then the ghosts ``others`` by
     owning rank and index (so each neighbour's ghosts are one contiguous block), and the local
@@ -304,7 +297,7 @@ def local_smeared_strain(op: SmearedStrain | StrainRecipe, part: np.ndarray, com
     snap, volume = _snap(op), op.volume
     del op  # a build of this rank's alone: its cell rows go (the force reads the subcell rows)
     counts = ptr[mine + 1] - ptr[mine]
-    orows = _ranges(ptr[mine], counts)
+    orows = ranges(ptr[mine], counts)
     touched = np.zeros(n, bool)
     _mark_columns(rows.indptr, rows.indices, orows, touched)
     touched[np.asarray(extra_nodes, np.int64)] = True

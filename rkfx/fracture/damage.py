@@ -45,6 +45,7 @@ from functools import cached_property
 
 import numpy as np
 
+from rkfx.approximation.sparse_rows import ranges
 from rkfx.materials import damage_law as law
 from rkfx.materials.elasticity import ElasticMaterial, out_of_plane_ratio, principal_direction
 from rkfx.errors import InputError
@@ -255,9 +256,8 @@ class CellGeometry:
     def subcells(self, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The subcells of ``nodes`` and the place in ``nodes`` of each subcell's node."""
         order, ptr = self.by_node
-        first, count = ptr[nodes], ptr[nodes + 1] - ptr[nodes]
-        where = np.repeat(np.arange(len(nodes)), count)
-        return order[np.arange(count.sum()) + np.repeat(first - (np.cumsum(count) - count), count)], where
+        count = ptr[nodes + 1] - ptr[nodes]
+        return order[ranges(ptr[nodes], count)], np.repeat(np.arange(len(nodes)), count)
 
 
 def cell_geometry(p: Particles | NodalDomains) -> CellGeometry:

@@ -11,6 +11,8 @@ import numba
 import numpy as np
 import scipy.sparse as sp
 
+from rkfx.approximation.sparse_rows import sort_by_column
+
 # Above this share of rows whose columns the new numbering leaves unsorted, ``renumbered``
 # sorts every row by scipy's sort (blocks of unknowns interleaved); below it, only those rows.
 UNSORTED_SHARE = 0.05
@@ -78,7 +80,7 @@ def renumbered(a: sp.spmatrix, new: np.ndarray, size: int) -> sp.csr_matrix:
         out.has_sorted_indices = False
         out.sort_indices()
     else:  # a few rows where the new numbering moves columns past others (a partition's cut)
-        _insertion_sorted(indptr, indices, data, rows)
+        sort_by_column(indptr, indices, data, rows)
         out.has_sorted_indices = True
     return out
 
@@ -105,19 +107,3 @@ def _moved(indptr, indices, data, new, out_ptr, out_idx, out_data, unsorted):
             if c < last:
                 unsorted[new[i]] = True
             last = c
-
-
-@numba.njit(parallel=True, cache=True)
-def _insertion_sorted(ptr, idx, data, rows):
-    """Sort the entries of ``rows`` by column, in place (stable)."""
-    for k in numba.prange(len(rows)):
-        r = rows[k]
-        for q in range(ptr[r] + 1, ptr[r + 1]):
-            c, v = idx[q], data[q]
-            p = q - 1
-            while p >= ptr[r] and idx[p] > c:
-                idx[p + 1] = idx[p]
-                data[p + 1] = data[p]
-                p -= 1
-            idx[p + 1] = c
-            data[p + 1] = v
