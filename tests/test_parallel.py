@@ -179,3 +179,21 @@ def test_renumbered_moves_rows_and_columns(size, density, swap):
     expected = sp.csr_matrix((c.data, (new[c.row], new[c.col])), shape=(size + 3, size + 3))
     assert got.has_sorted_indices and _sorted_rows(got)
     assert abs(got - expected).max() == 0 and got.nnz == a.nnz
+
+
+def test_sort_by_column_is_stable_and_takes_empty_rows():
+    """Entries of the chosen rows ordered by column, equal columns in their order, values moved
+    with them (one value or a row of values per entry); no rows or no entries are no work."""
+    from rkfx.approximation.sparse_rows import sort_by_column
+
+    indptr = np.array([0, 4, 4, 7])
+    indices = np.array([5, 1, 5, 0, 9, 3, 3], np.int32)
+    data = np.arange(7.0)
+    pairs = np.column_stack([data, -data])
+    sort_by_column(indptr, indices.copy(), pairs, rows=[2])
+    assert np.array_equal(pairs[:4, 0], data[:4])  # row 0 untouched
+    idx = indices.copy()
+    sort_by_column(indptr, idx, data)
+    assert np.array_equal(idx, [0, 1, 5, 5, 3, 3, 9]) and np.array_equal(data, [3, 1, 0, 2, 5, 6, 4])
+    sort_by_column(np.zeros(1, np.int64), np.zeros(0, np.int32), np.zeros((0, 2)))
+    sort_by_column(np.zeros(1, np.int64), np.zeros(0, np.int32), np.zeros(0))

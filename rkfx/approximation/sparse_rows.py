@@ -252,7 +252,7 @@ def sort_by_column(indptr: np.ndarray, indices: np.ndarray, data: np.ndarray, ro
     """Order the entries of ``rows`` (default all) of CSR-like arrays by column, in place and
     stably; ``data`` has one value per entry, or a row of values ``(nnz, k)``."""
     rows = np.arange(len(indptr) - 1) if rows is None else np.asarray(rows, np.int64)
-    _sort_by_column(indptr, indices, data.reshape(len(data), -1), rows)
+    _sort_by_column(indptr, indices, data[:, None] if data.ndim == 1 else data, rows)
 
 
 def ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
