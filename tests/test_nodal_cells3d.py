@@ -262,3 +262,38 @@ def test_build_times_and_points_per_node_at_scale():
     assert measure("median-dual octant", lambda: gmsh_solid("sphere_octant", radius=1.0, mesh_size=0.028),
                    median_dual_cells) < 10.0
     print("\n" + "\n".join(rows))
+
+
+@pytest.mark.parametrize("case", ["median jittered", "median octant", "box graded"])
+def test_cells_of_some_nodes_equal_the_whole_builds(case):
+    """A rank's build (``nodes=``): its nodes' volumes, facets (points by coordinates) and
+    subcells equal the whole build's value for value, in order; nothing else is built; and the
+    MSCNI rules over those nodes are the whole build's bit for bit."""
+    from rkfx.approximation.shape_functions import rk_approximation
+    from rkfx.integration.nodal_rules3d import mscni_rules_3d
+
+    p, build = CASES[case]()
+    whole = build(p)
+    nodes = np.flatnonzero(p.x[:, 0] < np.quantile(p.x[:, 0], 0.3))  # a rank's part: a slab
+    part = build(p, nodes)
+    assert np.array_equal(part.volume[nodes], whole.volume[nodes])
+    for i in nodes:
+        a, b = slice(whole.facet_ptr[i], whole.facet_ptr[i + 1]), slice(part.facet_ptr[i], part.facet_ptr[i + 1])
+        assert np.array_equal(part.points[part.facet_point[b]], whole.points[whole.facet_point[a]])
+        assert np.array_equal(part.facet_vector[b], whole.facet_vector[a])
+    mine = np.isin(whole.subcell_node, nodes)
+    kept = np.isin(part.subcell_node, nodes)
+    assert np.array_equal(part.subcell_node[kept], whole.subcell_node[mine])
+    assert np.array_equal(part.subcell_volume[kept], whole.subcell_volume[mine])
+    assert np.array_equal(part.subcell_centroid[kept], whole.subcell_centroid[mine])
+    assert len(part.facet_point) < 0.8 * len(whole.facet_point)
+    assert np.array_equal(part.boundary.area, whole.boundary.area)
+    rk = rk_approximation(p.x, p.spacing, 1.5)
+    _, rules_w, values_w = mscni_rules_3d(p, rk, whole, nodes=nodes)
+    _, rules_p, values_p = mscni_rules_3d(p, rk, part, nodes=nodes)
+    for qw, qp in zip([*rules_w, values_w], [*rules_p, values_p]):
+        assert np.array_equal(qw.weights, qp.weights) and np.array_equal(qw.points, qp.points)
+        for rw, rp in ((qw.values, qp.values), (qw.gradients, qp.gradients)):
+            if rw is not None:
+                assert np.array_equal(rw.indptr, rp.indptr) and np.array_equal(rw.indices, rp.indices)
+                assert np.array_equal(rw.data, rp.data)

@@ -13,8 +13,8 @@ def nodal_cells(p, nodes: np.ndarray | None = None):
 
     Args:
         p: The particles.
-        nodes: 2-D only: build just the cells around these nodes (a rank's own; see
-            ``rkfx.geometry.nodal_domains.nodal_domains``); 3-D cells are built whole.
+        nodes: Build just the cells around these nodes (a rank's own; see
+            ``rkfx.geometry.nodal_domains.nodal_domains`` and ``rkfx.geometry.nodal_cells3d``).
     """
     if p.x.shape[1] == 2:
         from rkfx.geometry.nodal_domains import nodal_domains  # noqa: PLC0415
@@ -22,7 +22,7 @@ def nodal_cells(p, nodes: np.ndarray | None = None):
         return nodal_domains(p, nodes=nodes)
     from rkfx.geometry.nodal_cells3d import box_cells, median_dual_cells  # noqa: PLC0415
 
-    return box_cells(p) if p.grid is not None else median_dual_cells(p)
+    return box_cells(p, nodes) if p.grid is not None else median_dual_cells(p, nodes)
 
 
 def cell_measures(cells) -> tuple[np.ndarray, np.ndarray]:
