@@ -7,11 +7,16 @@ ranks), each rank's peak RSS and, against a serial run
 saved with ``--save``, whether the damage, crack openings and displacements are the same bit
 for bit and the largest relative difference of the dissipation history.
 
+``--fem H`` runs the crack-band finite elements of element size H [m] instead
+(``fem_baselines.crack_band_dynamics``; on several ranks its time loop is distributed too).
+
 Usage:
     python bench/parallel_explicit.py [--nodes 450] [--t-end 8e-5] [--save serial.npz]
     mpiexec -n 2 python bench/parallel_explicit.py --compare serial.npz
+    python bench/parallel_explicit.py --fem 2e-4 --save fem.npz
 The cases give each rank its share of the cores for numba; set NUMBA_NUM_THREADS to choose.
-The last line reads ``<ranks> ranks x <threads> threads, <N> particles: <seconds> s stepping``.
+The last line reads ``<ranks> ranks x <threads> threads, <N> particles: <seconds> s stepping``
+(``cells`` for ``--fem``).
 """
 import argparse
 import resource
@@ -22,6 +27,7 @@ import numba
 import numpy as np
 from mpi4py import MPI
 
+from fem_baselines.crack_band_dynamics import kalthoff_crack_band
 from rkfx.cases import _dynamic_fracture as dyn
 from rkfx.cases import kalthoff as k
 from rkfx.fracture import damage as dm
@@ -34,6 +40,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--nodes", type=int, default=450, help="particles per side")
     ap.add_argument("--t-end", type=float, default=80e-6, help="end time [s]")
+    ap.add_argument("--fem", type=float, help="run the crack-band FEM of this element size [m] instead")
     ap.add_argument("--save", help="write the run's results (rank 0) to this .npz file")
     ap.add_argument("--compare", help="compare with the results saved by --save")
     args = ap.parse_args()
@@ -48,18 +55,24 @@ def main() -> None:
     material = dm.DamageMaterial(prm["E"], prm["nu"], prm["ft"], prm["GF"], "strain")
     comm.Barrier()
     t0 = time.perf_counter()
-    pl, track, model = k.setup(args.nodes, material, prm, comm=comm)
-    setup = time.perf_counter() - t0
-    run = dyn.simulate("bench", pl, model, track, k.model_conditions(pl, prm["v0"]), args.t_end, comm=comm)
+    if args.fem:
+        fem = kalthoff_crack_band(args.fem, args.t_end, E=prm["E"], nu=prm["nu"], rho=prm["rho"], ft=prm["ft"],
+                                  GF=prm["GF"], v0=prm["v0"], comm=comm)
+        run, n, what = fem.run, fem.num_cells, "cells"
+        setup = fem.wall_time_s - run.wall_time_s
+    else:
+        pl, track, model = k.setup(args.nodes, material, prm, comm=comm)
+        setup = time.perf_counter() - t0
+        run = dyn.simulate("bench", pl, model, track, k.model_conditions(pl, prm["v0"]), args.t_end, comm=comm)
+        n, what = pl.p.num_nodes, "particles"
     stepping = comm.allreduce(run.wall_time_s, op=MPI.MAX)
     setup = comm.allreduce(setup, op=MPI.MAX)
     rss = comm.gather(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20)  # GB (ru_maxrss in kB)
-    n = pl.p.num_nodes
     if comm.rank == 0:
-        print(f"{n:,} particles, {run.steps} steps to {1e6 * args.t_end:.0f} us; set-up {setup:.1f} s, stepping "
+        print(f"{n:,} {what}, {run.steps} steps to {1e6 * args.t_end:.0f} us; set-up {setup:.1f} s, stepping "
               f"{stepping:.1f} s ({1e3 * stepping / run.steps:.2f} ms per step)")
         print("peak RSS per rank [GB]: " + ", ".join(f"{r:.2f}" for r in rss))
-        print(f"dissipated {run.history[-1, 1]:.1f} J/m, cracked particles {int((run.opening >= 0.5).sum())}")
+        print(f"dissipated {run.history[-1, 1]:.1f} J/m, cracked {what} {int((run.opening >= 0.5).sum())}")
         if args.save:
             np.savez(args.save, damage=run.damage, opening=run.opening, displacement=run.displacement,
                      history=run.history)
@@ -70,7 +83,7 @@ def main() -> None:
                                                                             1e-300)
             print(f"against {args.compare}: damage, openings and displacements "
                   f"{'identical' if same else 'DIFFERENT'}; dissipation history within {gap:.1e}")
-        print(f"{comm.size} ranks x {numba.get_num_threads()} threads, {n} particles: {stepping:.1f} s stepping")
+        print(f"{comm.size} ranks x {numba.get_num_threads()} threads, {n} {what}: {stepping:.1f} s stepping")
 
 
 if __name__ == "__main__":

@@ -51,13 +51,19 @@ cells, summed at every sample.
 Stable step: dt = courant * min_e(a_e) / c_d with a_e the smallest altitude of cell e and
 c_d = sqrt((lambda + 2 mu) / rho).
 
-Parallelism: the mesh and the time loop live on one process. With a communicator of several
-ranks, rank 0 computes (on ``MPI.COMM_SELF``) and the result is broadcast to every rank.
+Parallelism: with a communicator of several ranks every rank meshes the plate and assembles
+the operators itself (on ``MPI.COMM_SELF``; the ranks check that their meshes agree), and the
+time loop is distributed (``rkfx.models.damage_ranks`` with the cell strains as a
+``rkfx.assembly.matrix_strain.MatrixStrain``): the vertices are split by recursive coordinate
+bisection, each rank steps its vertices' unknowns and the damage of its cells, and exchanges the
+loads of the cells and the forces at the vertices along its cuts each step. Every sum keeps the
+serial order, so the run is the serial one bit for bit; the result is on every rank.
 
 Units: SI (m, s, kg, Pa, N/m); energies are per unit thickness [J/m].
 """
 from __future__ import annotations
 
+import hashlib
 import time
 from dataclasses import dataclass
 from functools import partial
@@ -84,17 +90,18 @@ from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.assembly.smeared_strain import dilatational_wave_speed
 from rkfx.models.damage_dynamics import DamageRun, run_damage
 from rkfx.solvers.checkpoint import run_folder
-from rkfx.parallel.ranks import on_root
+from rkfx.assembly.matrix_strain import MatrixStrain
 from rkfx.solvers.central_difference import Constraint
+from rkfx.solvers.checkpoint import writes
 
 __all__ = [
-    "CellStrain",
     "CrackedPlateMesh",
     "DynamicCrackBandResult",
     "FemOperators",
     "cracked_plate_mesh",
     "fem_operators",
     "branching_crack_band",
+    "cell_strain",
     "edge_traction",
     "kalthoff_crack_band",
     "slit_sides",
@@ -324,22 +331,10 @@ def stable_time_step(m: CrackedPlateMesh, E: float, nu: float, rho: float, coura
 
 
 
-@dataclass(frozen=True)
-class CellStrain:
+def cell_strain(ops: FemOperators) -> MatrixStrain:
     """The cell strains of linear triangles as the strain operator of ``rkfx.models.damage_dynamics``:
     damage points are the cells, ``strain`` = B d, ``force`` = B^T (sigma area)."""
-
-    ops: FemOperators
-
-    @property
-    def num_nodes(self) -> int:
-        return len(self.ops.area)
-
-    def strain(self, d: np.ndarray) -> np.ndarray:
-        return (self.ops.B @ d).reshape(-1, 3)
-
-    def force(self, stress: np.ndarray) -> np.ndarray:
-        return self.ops.BT @ (stress * self.ops.area[:, None]).ravel()
+    return MatrixStrain(ops.B, ops.BT, ops.area)
 
 
 # --------------------------------------------------------------------------- driver
@@ -384,6 +379,16 @@ class DynamicCrackBandResult:
         return self.run.damage
 
 
+def _same_mesh(m: CrackedPlateMesh, comm: MPI.Comm) -> None:
+    """Raise unless every rank of ``comm`` meshed the plate alike (collective)."""
+    if comm is None or comm.size == 1:
+        return
+    mine = hashlib.sha256(m.x.tobytes() + m.triangles.tobytes()).hexdigest()
+    if len(set(comm.allgather(mine))) > 1:
+        raise InputError("the ranks meshed the plate differently (gmsh or dolfinx not deterministic here); "
+                         "run the crack-band FEM on one rank")
+
+
 def _identity_rows(dofs: np.ndarray, n2: int) -> sp.csr_matrix:
     k = len(dofs)
     return sp.csr_matrix((np.ones(k), (np.arange(k), dofs)), shape=(k, n2))
@@ -407,10 +412,11 @@ def _check_run(material: dm.DamageMaterial, rho: float, t_end: float, samples: i
 
 def _crack_band(mesh, material: dm.DamageMaterial, rho: float, t_end: float, regularized: bool,
                 kappa_c: float | None, courant: float, samples: int, label: str, conditions, io: dict,
-                wall: float) -> DynamicCrackBandResult:
+                wall: float, comm: MPI.Comm) -> DynamicCrackBandResult:
     """The explicit crack-band run on the mesh ``mesh()``; ``conditions(m, ops) -> (constraints,
     external_force)`` sets up the problem's loads. A finished run in ``io["resume"]`` is read
-    back with its mesh's nodes and cells, without meshing again."""
+    back with its mesh's nodes and cells, without meshing again. On several ranks every rank
+    meshes, and the time loop is distributed (module docstring)."""
     work_dir, resume = io.get("work_dir"), io.get("resume")
     done = None if resume is None else Path(resume) / run_folder(label)
     if done is not None and (done / "result.npz").is_file() and (done / MESH_FILE).is_file():
@@ -422,6 +428,7 @@ def _crack_band(mesh, material: dm.DamageMaterial, rho: float, t_end: float, reg
         return DynamicCrackBandResult(len(x), len(tri), h, run, x[tri].mean(axis=1), x, tri,
                                       time.perf_counter() - wall)
     m = mesh()
+    _same_mesh(m, comm)
     if regularized:
         # the band width area / chord stays below the longest side
         h_max = 2.0 * material.E * material.GF / material.ft**2
@@ -435,12 +442,12 @@ def _crack_band(mesh, material: dm.DamageMaterial, rho: float, t_end: float, reg
                             kappa_c=kappa_c, regularized=regularized, band_factor=2.0)
     constraints, external_force = conditions(m, ops)
     frames = io.get("frames")
-    run = run_damage(label, CellStrain(ops), ops.mass, dt, model, None, constraints, t_end, external_force,
+    run = run_damage(label, cell_strain(ops), ops.mass, dt, model, None, constraints, t_end, external_force,
                      samples=samples, checkpoint_every=io.get("checkpoint_every", 0),
                      work_dir=None if work_dir is None else Path(work_dir),
-                     resume=None if resume is None else Path(resume),
+                     resume=None if resume is None else Path(resume), comm=comm, x=m.x,
                      frames=None if frames is None else frames(m.x, m.triangles))
-    if work_dir is not None:  # beside result.npz, so that a resume reads the run back without meshing
+    if work_dir is not None and writes(comm):  # beside result.npz, so that a resume reads the run back without meshing
         folder = Path(work_dir) / run_folder(label)
         folder.mkdir(parents=True, exist_ok=True)  # a run read back from elsewhere wrote nothing here
         np.savez(folder / MESH_FILE, x=m.x, triangles=m.triangles, h=m.h)
@@ -471,7 +478,7 @@ def kalthoff_crack_band(h: float, t_end: float = 80e-6, *, E: float = 1.9e11, nu
         samples: History samples over the run.
         label, checkpoint_every, work_dir, resume: As for ``rkfx.models.damage_dynamics.run_damage``
             (default label ``fem-crack-band h=<h>``).
-        comm: Communicator; rank 0 computes and broadcasts the result.
+        comm: Communicator; on several ranks the time loop is distributed (module docstring).
         frames: ``frames(x, triangles)`` gives the ``rkfx.models.damage_dynamics.Frames`` that
             receive the fields through time on the mesh (``None``: none are written).
 
@@ -499,9 +506,9 @@ def kalthoff_crack_band(h: float, t_end: float = 80e-6, *, E: float = 1.9e11, nu
 
         io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume, "frames": frames}
         return _crack_band(mesh, material, rho, t_end, regularized, kappa_c, courant, samples,
-                           label or f"fem-crack-band h={h:g}", conditions, io, wall)
+                           label or f"fem-crack-band h={h:g}", conditions, io, wall, comm)
 
-    return on_root(comm, run)
+    return run()
 
 
 def edge_traction(m: CrackedPlateMesh, sigma: float) -> np.ndarray:
@@ -551,6 +558,6 @@ def branching_crack_band(h: float, t_end: float = 80e-6, *, E: float = 3.2e10, n
 
         io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume, "frames": frames}
         return _crack_band(mesh, material, rho, t_end, regularized, kappa_c, courant, samples,
-                           label or f"fem-crack-band h={h:g}", conditions, io, wall)
+                           label or f"fem-crack-band h={h:g}", conditions, io, wall, comm)
 
-    return on_root(comm, run)
+    return run()

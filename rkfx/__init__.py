@@ -29,6 +29,7 @@ data path (see docs/core.md):
         boundary         boundary integration, collocated conditions, Nitsche terms
         smeared_strain   the smeared strain of explicit SCNI, lumped mass, stable step (eq. 4.31-4.35)
         local_strain     one rank's share of the smeared strain: strains at its particles, forces on its nodes
+        matrix_strain    strains B d and forces B^T (Sigma V) of a given matrix (FEM cells), whole or a rank's share
     materials       constitutive laws
         elasticity       the elastic law: 2-D (plane strain or stress) and 3-D, principal directions
         damage_law       Mazars' strain and the softening law compiled, shared by statics and dynamics

@@ -197,3 +197,17 @@ def test_sort_by_column_is_stable_and_takes_empty_rows():
     assert np.array_equal(idx, [0, 1, 5, 5, 3, 3, 9]) and np.array_equal(data, [3, 1, 0, 2, 5, 6, 4])
     sort_by_column(np.zeros(1, np.int64), np.zeros(0, np.int32), np.zeros((0, 2)))
     sort_by_column(np.zeros(1, np.int64), np.zeros(0, np.int32), np.zeros(0))
+
+
+def test_points_go_to_the_rank_owning_most_of_their_nodes():
+    """``point_parts``: a point's owner holds most of its row nodes; a tie goes to the lowest rank."""
+    import scipy.sparse as sp
+
+    from rkfx.assembly.matrix_strain import point_parts
+
+    nodes = [[0, 1, 2], [2, 3, 4], [1, 3, 5]]  # parts 0 0 1 | 1 1 2 | 0 1 2 (a three-way tie)
+    part = np.array([0, 0, 1, 1, 2, 2])
+    rows = [(3 * p + k, 2 * i + c) for p, ns in enumerate(nodes) for k in range(3) for i in ns for c in range(2)]
+    r, c = np.array(rows).T
+    B = sp.csr_matrix((np.ones(len(r)), (r, c)), shape=(9, 12))
+    assert point_parts(B, part).tolist() == [0, 1, 0]

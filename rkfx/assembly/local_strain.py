@@ -51,8 +51,35 @@ class LocalStabilization:
     owner: np.ndarray
 
 
+class LocalNodes:
+    """The local nodes of a rank's share of a strain operator: ``nodes`` (global index of every
+    local node, the owned ones first), ``owned_nodes`` and ``node_of`` (local index of every
+    global node, -1 if not local), and the unknowns they carry."""
+
+    @property
+    def num_local(self) -> int:
+        return len(self.nodes)
+
+    @property
+    def dofs(self) -> np.ndarray:
+        """Global interleaved unknowns of the local nodes, shape ``(2 num_local,)``."""
+        return (2 * self.nodes[:, None] + np.arange(2)).ravel()
+
+    def local_dofs(self, dofs: np.ndarray) -> np.ndarray:
+        """Local index of global interleaved unknowns (-1 where not local)."""
+        node = self.node_of[np.asarray(dofs) // 2]
+        return np.where(node >= 0, 2 * node + np.asarray(dofs) % 2, -1)
+
+    @property
+    def owned_dofs(self) -> np.ndarray:
+        """1.0 on the local unknowns of owned nodes, 0.0 on ghost copies, ``(2 num_local,)``."""
+        w = np.zeros((self.num_local, 2))
+        w[self.owned_nodes] = 1.0
+        return w.ravel()
+
+
 @dataclass(frozen=True)
-class LocalSmearedStrain:
+class LocalSmearedStrain(LocalNodes):
     """A rank's share of a ``SmearedStrain`` (see the module docstring).
 
     Attributes:
@@ -95,27 +122,6 @@ class LocalSmearedStrain:
     def num_nodes(self) -> int:
         """The number of damage points of this rank (its owned particles)."""
         return len(self.points)
-
-    @property
-    def num_local(self) -> int:
-        return len(self.nodes)
-
-    @property
-    def dofs(self) -> np.ndarray:
-        """Global interleaved unknowns of the local nodes, shape ``(2 num_local,)``."""
-        return (2 * self.nodes[:, None] + np.arange(2)).ravel()
-
-    def local_dofs(self, dofs: np.ndarray) -> np.ndarray:
-        """Local index of global interleaved unknowns (-1 where not local)."""
-        node = self.node_of[np.asarray(dofs) // 2]
-        return np.where(node >= 0, 2 * node + np.asarray(dofs) % 2, -1)
-
-    @property
-    def owned_dofs(self) -> np.ndarray:
-        """1.0 on the local unknowns of owned nodes, 0.0 on ghost copies, ``(2 num_local,)``."""
-        w = np.zeros((self.num_local, 2))
-        w[self.owned_nodes] = 1.0
-        return w.ravel()
 
     def strain(self, d: np.ndarray) -> np.ndarray:
         """Smeared strains at the owned points, shape ``(num_owned, 3)``, for local d."""
@@ -175,7 +181,7 @@ class LocalSmearedStrain:
         return self.force(stress, differences)
 
 
-def _numbering(owned: np.ndarray, others: np.ndarray, owner: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
+def local_numbering(owned: np.ndarray, others: np.ndarray, owner: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
     """Local order of global entries: ``owned`` first (ascending), then the ghosts ``others`` by
     owning rank and index (so each neighbour's ghosts are one contiguous block), and the local
     index of every global entry (-1 for the others), shape ``(size,)``."""
@@ -301,7 +307,7 @@ def local_smeared_strain(op: SmearedStrain | StrainRecipe, part: np.ndarray, com
     touched = np.zeros(n, bool)
     _mark_columns(rows.indptr, rows.indices, orows, touched)
     touched[np.asarray(extra_nodes, np.int64)] = True
-    nodes, node_of = _numbering(mine, np.flatnonzero(touched), part, n)
+    nodes, node_of = local_numbering(mine, np.flatnonzero(touched), part, n)
     # The rows touching an owned node: the entries in owned columns, each node's in row order.
     trows, t_data, t_counts = _owned_columns(sources or [rows], mine, n)
     del sources
@@ -309,7 +315,7 @@ def local_smeared_strain(op: SmearedStrain | StrainRecipe, part: np.ndarray, com
         gathered_rows(rows, orows, node_of, len(nodes))
     read = np.zeros(rows.num_rows, np.bool_)
     read[trows] = True
-    lrows, row_of = _numbering(orows, np.flatnonzero(read), part[row_point], rows.num_rows)
+    lrows, row_of = local_numbering(orows, np.flatnonzero(read), part[row_point], rows.num_rows)
     del read
     t_indptr = np.zeros(len(mine) + 1, np.int64)
     np.cumsum(t_counts, out=t_indptr[1:])

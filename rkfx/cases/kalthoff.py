@@ -53,9 +53,9 @@ unregularized_h, no_tracking_h, fem_h, support_factor, courant, radius, forward,
 angle_radius. Long runs: ``--checkpoint-every N`` writes each model's state every N steps to
 OUT/checkpoints/, and ``--resume DIR`` continues an interrupted invocation (finished models are
 read back). A resume with other parameters is refused in one line (``--recompute`` computes the
-runs again). Under ``mpiexec`` the RKPM models are distributed over the ranks
-(``rkfx.models.damage_ranks``: the serial damage bit for bit); the crack-band FEM models run on
-rank 0.
+runs again). Under ``mpiexec`` the RKPM and the crack-band FEM models are distributed over the
+ranks (``rkfx.models.damage_ranks``: the serial damage bit for bit; every rank meshes the FEM
+plate, whose time loop the ranks then share).
 
     python -m rkfx.cases.kalthoff [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR] [--vtk]
 

@@ -59,6 +59,7 @@ from rkfx.fracture.damage import DamageModel, crack_opening, dissipation_density
 from rkfx.materials.damage_law import damage_kernel, strain_kernel
 from rkfx.errors import InputError
 from rkfx.parallel.ranks import on_root
+from rkfx.assembly.matrix_strain import MatrixStrain
 from rkfx.assembly.smeared_strain import SmearedStrain, StrainRecipe
 from rkfx.solvers.central_difference import CentralDifference, Constraint, ExplicitDynamics, ExplicitState
 from rkfx.solvers.checkpoint import copy_into, has_checkpoint, log, read_arrays, run_folder, save_arrays
@@ -386,11 +387,12 @@ def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, mode
         work_dir: Where finished results and checkpoints go.
         resume: Work directory of an interrupted invocation: a finished result there is
             returned as is, a checkpoint is continued.
-        comm: An MPI communicator (mpi4py) or ``None``. With several ranks and the particle
-            positions ``x``, a ``SmearedStrain`` run is distributed (``rkfx.models.damage_ranks``:
-            the serial result bit for bit, on every rank); other runs are serial: rank 0 runs
-            them and writes the files, and every rank receives the result (or the error).
-        x: Particle positions, shape ``(n, 2)`` [m], which the ranks split by RCB.
+        comm: An MPI communicator (mpi4py) or ``None``. With several ranks and the node
+            positions ``x``, a ``SmearedStrain`` or ``MatrixStrain`` run is distributed
+            (``rkfx.models.damage_ranks``: the serial result bit for bit, on every rank); other
+            runs are serial: rank 0 runs them and writes the files, and every rank receives the
+            result (or the error).
+        x: Node (particle) positions, shape ``(n, 2)`` [m], which the ranks split by RCB.
         frames: Receives the fields through time (``Frames``); a finished run read back writes
             its end state.
         progress: Called with the step number at every history sample (e.g. a progress bar).
@@ -398,7 +400,7 @@ def run_damage(label: str, op: StrainOperator, mass: np.ndarray, dt: float, mode
     parallel = comm is not None and comm.size > 1
     if isinstance(op, StrainRecipe) and not (parallel and x is not None):
         op = op.build()  # one process builds the whole operator
-    if parallel and (x is None or not isinstance(op, SmearedStrain | StrainRecipe)):
+    if parallel and (x is None or not isinstance(op, SmearedStrain | StrainRecipe | MatrixStrain)):
         return on_root(comm, lambda: run_damage(label, op, mass, dt, model, track, constraints, t_end,
                                                 external_force, samples, checkpoint_every, work_dir, resume,
                                                 frames=frames, progress=progress))

@@ -26,7 +26,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from rkfx.assembly.local_strain import LocalSmearedStrain, local_smeared_strain
+from rkfx.assembly.local_strain import LocalNodes, local_smeared_strain
+from rkfx.assembly.matrix_strain import MatrixStrain, local_matrix_strain
 from rkfx.fracture.damage import DamageModel, initiate
 from rkfx.fracture.tracking import Tracking
 from rkfx.models.damage_dynamics import DamageDynamics, DamageForce, damage_field
@@ -66,7 +67,7 @@ class RankDamageForce(DamageForce):
     """``DamageForce`` of one rank's points: initiations are gathered over the ranks, so the
     tracking state (which particles may initiate, and their parents) is the same everywhere."""
 
-    def __init__(self, op: LocalSmearedStrain, model: DamageModel, local_model: DamageModel, field,
+    def __init__(self, op: LocalNodes, model: DamageModel, local_model: DamageModel, field,
                  track: Tracking | None, dt: float, comm):
         super().__init__(op, local_model, field, track, dt)
         self.whole, self.comm = model, comm
@@ -109,15 +110,17 @@ class RankDamage(DamageDynamics):
     Args:
         op, mass, model, track, dt, constraints, external_force: The whole problem, as for
             ``DamageDynamics`` (``op`` a ``SmearedStrain``, or its ``StrainRecipe``: then this
-            rank builds only the rows it reads, ``local_smeared_strain``).
-        part: Rank of each particle, shape ``(n,)``.
+            rank builds only the rows it reads, ``local_smeared_strain``; or a
+            ``rkfx.assembly.matrix_strain.MatrixStrain``, whose points need not be the nodes).
+        part: Rank of each node (particle), shape ``(n,)``.
         comm: The communicator (mpi4py).
     """
 
     def __init__(self, op, mass, model: DamageModel, track: Tracking | None, dt: float, constraints, external_force,
                  part: np.ndarray, comm):
         columns = np.unique(np.concatenate([c.G.indices // 2 for c in constraints])) if constraints else []
-        local = local_smeared_strain(op, part, comm, extra_nodes=columns)
+        local = local_matrix_strain(op, part, comm, columns) if isinstance(op, MatrixStrain) else \
+            local_smeared_strain(op, part, comm, extra_nodes=columns)
         points, dofs = local.points, local.dofs
         self.op, self.damage_model = local, restricted(model, points)
         self.field = damage_field(self.damage_model, None, dt)
@@ -129,23 +132,29 @@ class RankDamage(DamageDynamics):
                                   self.field.arrays | {"allowed_all": self.force.allowed,
                                                        "parent_all": self.force.parent})
         self.share = MpiShare(comm, local.owned_dofs)
-        self.comm, self.num_points = comm, op.num_nodes
+        self.comm, self.num_points, self.num_whole_nodes = comm, op.num_nodes, len(mass) // 2
 
     def gather(self, values: np.ndarray) -> np.ndarray:
         """The whole array of a per-point quantity from every rank's owned points (collective)."""
-        pieces = self.comm.allgather((self.op.points, np.asarray(values)))
-        out = np.empty((self.num_points, *pieces[0][1].shape[1:]), pieces[0][1].dtype)
-        for points, v in pieces:
-            out[points] = v
-        return out
+        return _gathered(self.comm, self.op.points, np.asarray(values), self.num_points)
 
     def gather_nodes(self, local: np.ndarray) -> np.ndarray:
         """The whole interleaved vector ``(2 n,)`` from the local vectors of every rank (collective)."""
-        owned = np.asarray(local).reshape(-1, 2)[self.op.owned_nodes]
-        return self.gather(owned).ravel()
+        op = self.op
+        owned = np.asarray(local).reshape(-1, 2)[op.owned_nodes]
+        return _gathered(self.comm, op.nodes[op.owned_nodes], owned, self.num_whole_nodes).ravel()
 
 
-def _columns(g, local: LocalSmearedStrain):
+def _gathered(comm, index: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
+    """``values`` of the global entries ``index`` of every rank, as one array of ``size`` rows."""
+    pieces = comm.allgather((index, values))
+    out = np.empty((size, *values.shape[1:]), values.dtype)
+    for at, v in pieces:
+        out[at] = v
+    return out
+
+
+def _columns(g, local: LocalNodes):
     """``g`` on the local unknowns (every column of ``g`` is local), each row's entries kept in
     their order, so that G w sums as serially."""
     import scipy.sparse as sp  # noqa: PLC0415
