@@ -10,8 +10,8 @@ on the rank's local vectors as it would serially; per step the ranks exchange:
   ghost nodes (two neighbour-only halo exchanges, ``rkfx.parallel.halo``);
 * when a particle initiates anywhere, the new crack particles and their normals (one small
   all-gather), so that every rank marks the same tracking candidates (4.22), in the serial
-  order, also across the partition boundaries; whether any initiated is one all-reduce of a
-  count per step (with tracking on);
+  order, also across the partition boundaries; how many initiated on each rank is one
+  all-gather of a count per step (with tracking on);
 * the energies and the history samples (all-reduces of a few numbers).
 
 The constraint rows are replicated (the columns of G are ghosts everywhere), so every rank
@@ -76,12 +76,23 @@ class RankDamageForce(DamageForce):
         self.allowed = track.seeds.copy() if tracked else np.ones(n, bool)
         self.parent = np.full(n, -1, np.int64)
         self.tracked = tracked
-        self._count = np.zeros(1, np.int64)
+        self._counts = np.zeros(comm.size, np.int64)
+        self._one = np.zeros(1, np.int64)
 
-    def _anywhere(self, count: int) -> bool:
-        """Whether any rank has initiations in this evaluation (an all-reduce of one number)."""
-        self._count[0] = count
-        return bool(_summed(self.comm, self._count)[0])
+    def _gathered(self, ids: np.ndarray, normals: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """The initiations of every rank in this evaluation, rank by rank (ids, normals), or
+        ``None`` if there are none: an all-gather of the counts, then one of (id, n_x, n_y)
+        triples as doubles (ids below 2^53 are exact). Collective."""
+        self._one[0] = len(ids)
+        self.comm.Allgather(self._one, self._counts)
+        total = int(self._counts.sum())
+        if total == 0:
+            return None
+        mine = np.empty((len(ids), 3))
+        mine[:, 0], mine[:, 1:] = ids, normals
+        every = np.empty((total, 3))
+        self.comm.Allgatherv(mine, [every, 3 * self._counts])
+        return every[:, 0].astype(np.int64), np.ascontiguousarray(every[:, 1:])
 
     def _initiate_all(self, new: np.ndarray) -> None:
         f, points = self.field, self.op.points
@@ -89,12 +100,14 @@ class RankDamageForce(DamageForce):
             initiate(self.whole, points[new], self._effective[new], f.normal, f.chord, f.kappa_c, at=new)
             f.damaged[new] = True
             f.initiation_time[new] = f.clock[0]
-        if not self.tracked or not self._anywhere(new.size):
+        if not self.tracked:
             return
-        pieces = self.comm.allgather((points[new], f.normal[new]))
-        ids = np.concatenate([p[0] for p in pieces])
+        gathered = self._gathered(points[new], f.normal[new])
+        if gathered is None:
+            return
+        ids, normals = gathered
         order = np.argsort(ids, kind="stable")  # ascending, as serially
-        cand, by = self.track.candidates(ids[order], np.concatenate([p[1] for p in pieces])[order], self.parent)
+        cand, by = self.track.candidates(ids[order], normals[order], self.parent)
         fresh = ~self.allowed[cand]
         self.parent[cand[fresh]] = by[fresh]
         self.allowed[cand] = True
