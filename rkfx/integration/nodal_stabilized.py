@@ -23,6 +23,7 @@ node position: they overlap and leave gaps (non-conforming, Fig. 6.3b).
 """
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from rkfx.approximation.semi_lagrangian import MovingRK, evaluate_moving
@@ -163,11 +164,25 @@ def smoothed_gradients(rk: MovingRK, cells: NodalCells) -> SparseRows:
     return combine_rows(values, 4 * np.arange(n + 1), np.arange(4 * n), weight)
 
 
-def _pattern_sums(rows: SparseRows, weights: np.ndarray) -> np.ndarray:
-    """``sum_L w_L [I in row L]`` for every column I."""
-    out = np.zeros(rows.num_cols)
-    np.add.at(out, rows.indices, np.repeat(weights, np.diff(rows.indptr)))
-    return out
+def _column_sums(rows: SparseRows, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``sum_L w_L row_L`` of every column, shape ``(num_cols, num_components)``, and
+    ``sum_L w_L [I in row L]`` of every column I (sums in entry order)."""
+    sums = np.zeros((rows.num_cols, rows.data.shape[1]))
+    covered = np.zeros(rows.num_cols)
+    _add_columns(rows.indptr, rows.indices, np.ascontiguousarray(rows.data), np.asarray(weights, float), sums, covered)
+    return sums, covered
+
+
+@numba.njit(cache=True)
+def _add_columns(indptr, indices, data, weights, sums, covered):
+    """sums[I] += w_L row_L[I] and covered[I] += w_L over the rows L, in entry order."""
+    for r in range(len(indptr) - 1):
+        w = weights[r]
+        for e in range(indptr[r], indptr[r + 1]):
+            i = indices[e]
+            for k in range(data.shape[1]):
+                sums[i, k] += data[e, k] * w
+            covered[i] += w
 
 
 def vc_correction(gradients: SparseRows, weights: np.ndarray, boundary_values: SparseRows,
@@ -178,9 +193,8 @@ def vc_correction(gradients: SparseRows, weights: np.ndarray, boundary_values: S
     ``grad N_I + zeta_I`` meet ``sum_L w_L grad^c N_I(x_L) = sum_b N_I(x_b) n_b w_b`` (6.66) exactly.
     """
     n = gradients.num_cols
-    domain = np.stack([gradients.matrix(k).T @ weights for k in range(2)], axis=1)
+    domain, covered = _column_sums(gradients, weights)
     gamma = boundary_values.matrix().T @ boundary.normal_length
-    covered = _pattern_sums(gradients, weights)
     zeta = np.zeros((n, 2))
     hit = covered > 0
     zeta[hit] = (gamma[hit] - domain[hit]) / covered[hit, None]
@@ -189,7 +203,17 @@ def vc_correction(gradients: SparseRows, weights: np.ndarray, boundary_values: S
 
 def corrected(gradients: SparseRows, zeta: np.ndarray) -> SparseRows:
     """Gradient rows with zeta_I added to every entry of node I (6.69)."""
-    return SparseRows(gradients.indptr, gradients.indices, gradients.data + zeta[gradients.indices], gradients.num_cols)
+    data = np.empty_like(gradients.data)
+    _plus_columns(np.ascontiguousarray(gradients.data), gradients.indices, np.ascontiguousarray(zeta, float), data)
+    return SparseRows(gradients.indptr, gradients.indices, data, gradients.num_cols)
+
+
+@numba.njit(parallel=True, cache=True)
+def _plus_columns(data, indices, zeta, out):
+    """out[e] = data[e] + zeta[indices[e]] for every entry e."""
+    for e in numba.prange(len(indices)):
+        for k in range(data.shape[1]):
+            out[e, k] = data[e, k] + zeta[indices[e], k]
 
 
 def second_gradient_rows(rk: MovingRK) -> tuple[SparseRows, SparseRows]:
