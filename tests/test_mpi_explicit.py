@@ -111,3 +111,14 @@ def test_crack_band_fem_on_ranks_is_the_serial_run(serial_fem, tmp_path, ranks):
     assert any(max(r["series"].get("damage", [0])) == 1.0 for r in serial_fem.values())  # cracked cells compared
     run = next(d for d in (out / "checkpoints").iterdir() if d.is_dir())
     assert sorted(p.name for p in run.iterdir() if p.is_dir()) == [f"rank{r}-of-{ranks}" for r in range(ranks)]
+
+
+def test_branching_crack_band_fem_on_two_ranks_is_the_serial_run(tmp_path):
+    """The branching plate's crack-band FEM (no supports, edge tractions) on 2 ranks: the same
+    damaged cells and damage, histories to round-off."""
+    args = ["-m", "rkfx.cases.crack_branching", "--quick", "--method", "fem"]
+    mpiexec(1, *args, "--out", str(tmp_path / "serial"))
+    mpiexec(2, *args, "--out", str(tmp_path / "ranks"))
+    serial = runs(tmp_path / "serial")
+    assert any(r["series"].get("damaged_index") for r in serial.values())
+    assert_same_runs(serial, runs(tmp_path / "ranks"))
