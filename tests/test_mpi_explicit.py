@@ -91,26 +91,31 @@ def test_a_share_runs_stencils_and_is_the_whole_operator(ranks):
     assert float(done.stdout.split("coverage")[1]) > 0.3
 
 
-FEM_ARGS = ["--method", "fem", "--set", "fem_h=2e-3", "t_end=3e-5", "--checkpoint-every", "50"]
+FEM_ARGS = ["--method", "fem", "--set", "fem_h=2e-3", "t_end=3e-5", "--checkpoint-every", "50", "--vtk"]
 
 
 @pytest.fixture(scope="module")
 def serial_fem(tmp_path_factory):
     out = tmp_path_factory.mktemp("serial_fem")
     mpiexec(1, "-m", "rkfx.cases.kalthoff", *FEM_ARGS, "--out", str(out))
-    return runs(out)
+    return out
 
 
 @pytest.mark.parametrize("ranks", [2, 3])
 def test_crack_band_fem_on_ranks_is_the_serial_run(serial_fem, tmp_path, ranks):
     """The crack-band FEM's time loop is distributed too (``rkfx.assembly.matrix_strain``): the
-    same damaged cells, damage and openings bit for bit, one checkpoint folder per rank."""
+    same damaged cells, damage and openings bit for bit, one checkpoint folder per rank, and the
+    ParaView frames written once (rank 0), byte for byte the serial run's."""
     out = tmp_path / "run"
     mpiexec(ranks, "-m", "rkfx.cases.kalthoff", *FEM_ARGS, "--out", str(out))
-    assert_same_runs(serial_fem, runs(out))
-    assert any(max(r["series"].get("damage", [0])) == 1.0 for r in serial_fem.values())  # cracked cells compared
+    serial = runs(serial_fem)
+    assert_same_runs(serial, runs(out))
+    assert any(max(r["series"].get("damage", [0])) == 1.0 for r in serial.values())  # cracked cells compared
     run = next(d for d in (out / "checkpoints").iterdir() if d.is_dir())
     assert sorted(p.name for p in run.iterdir() if p.is_dir()) == [f"rank{r}-of-{ranks}" for r in range(ranks)]
+    frames = sorted(p.name for p in (out / "vtk").glob("*.vtu"))
+    assert frames and frames == sorted(p.name for p in (serial_fem / "vtk").glob("*.vtu"))
+    assert all((out / "vtk" / f).read_bytes() == (serial_fem / "vtk" / f).read_bytes() for f in frames)
 
 
 def test_branching_crack_band_fem_on_two_ranks_is_the_serial_run(tmp_path):

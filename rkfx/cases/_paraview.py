@@ -68,14 +68,15 @@ def damage_frames(folder: Path | None, label: str, points, cells, values, comm=N
     return Frames(write, count)
 
 
-def crack_band_frames(folder: Path | None, label: str, count: int = 20):
+def crack_band_frames(folder: Path | None, label: str, comm=None, count: int = 20):
     """For ``frames=`` of the crack-band FEM runs: ``(x, triangles) -> Frames`` writing damage and
-    opening per element, displacement and velocity per vertex; ``None`` without ``--vtk``."""
+    opening per element, displacement and velocity per vertex (rank 0 of ``comm`` writes; the
+    fields reach it gathered); ``None`` without ``--vtk``."""
     if folder is None:
         return None
 
     def frames(x, triangles) -> Frames:
-        series = MeshSeries(folder, label, x, triangles)
+        series = MeshSeries(folder, label, x, triangles, comm=comm)
 
         def write(t, damage, crack_opening, displacement, velocity):
             series.write(t, point_data={"displacement": displacement, "velocity": velocity},

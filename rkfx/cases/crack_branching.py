@@ -242,7 +242,7 @@ def _fem(h: float, prm: dict, io: dict) -> Run:
     res = branching_crack_band(h, prm["t_end"], E=prm["E"], nu=prm["nu"], rho=prm["rho"], ft=prm["ft"], GF=prm["GF"],
                                sigma=prm["sigma"], plane=prm["plane"], width=LX, height=LY, a1=A1, a2=A2,
                                courant=prm["courant"], label=label,
-                               frames=_paraview.crack_band_frames(io.pop("vtk"), label), **io)
+                               frames=_paraview.crack_band_frames(io.pop("vtk"), label, io.get("comm")), **io)
     r = res.run
     columns = np.arange(A1 + 0.5 * h, LX, h)
     counts = dyn.count_branches(res.centroids, r.opening, columns, h, 3.0 * h)

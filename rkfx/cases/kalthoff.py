@@ -220,7 +220,7 @@ def _fem(n, prm, io) -> Run:
     label = f"fem-crack-band n={n}"
     res = kalthoff_crack_band(h, prm["t_end"], E=prm["E"], nu=prm["nu"], rho=prm["rho"], ft=prm["ft"], GF=prm["GF"],
                               v0=prm["v0"], courant=prm["courant"], label=label,
-                              frames=_paraview.crack_band_frames(io.pop("vtk"), label), **io)
+                              frames=_paraview.crack_band_frames(io.pop("vtk"), label, io.get("comm")), **io)
     r = res.run
     angle = dyn.crack_angle(res.centroids, r.opening, np.array([A1, A2]), prm["angle_radius"])
     below = int(np.sum((r.opening >= dyn.CRACKED) & (res.centroids[:, 1] < A2 - 3 * h)))
