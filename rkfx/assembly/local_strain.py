@@ -54,7 +54,17 @@ class LocalStabilization:
 class LocalNodes:
     """The local nodes of a rank's share of a strain operator: ``nodes`` (global index of every
     local node, the owned ones first), ``owned_nodes`` and ``node_of`` (local index of every
-    global node, -1 if not local), and the unknowns they carry."""
+    global node, -1 if not local), the unknowns they carry, and the force's two exchanges over
+    ``row_halo`` (loads of the ghost rows) and ``node_halo`` (force at the ghost nodes)."""
+
+    def _exchanged(self, load: np.ndarray, transposed) -> np.ndarray:
+        """The local force from the owned rows' ``load``: the ghost rows' loads brought in,
+        ``transposed(out)`` writing the owned nodes' force, the ghost nodes' force brought in."""
+        self.row_halo.exchange(load)
+        f = np.empty(2 * self.num_local)
+        transposed(f[:2 * len(self.owned_nodes)])
+        self.node_halo.exchange(f.reshape(-1, 2))
+        return f
 
     @property
     def num_local(self) -> int:
@@ -158,15 +168,6 @@ class LocalSmearedStrain(LocalNodes):
         """The force of the stencil's loads (slot major, and as rows in ``load``)."""
         return self._exchanged(load, lambda out: self.stencil.transposed(slot_major, load, self.rows_t,
                                                                          self.row_weight, out))
-
-    def _exchanged(self, load: np.ndarray, transposed) -> np.ndarray:
-        """The local force from the owned rows' ``load``: the ghost rows' loads brought in,
-        ``transposed(out)`` writing the owned nodes' force, the ghost nodes' force brought in."""
-        self.row_halo.exchange(load)
-        f = np.empty(2 * self.num_local)
-        transposed(f[:2 * len(self.owned_nodes)])
-        self.node_halo.exchange(f.reshape(-1, 2))
-        return f
 
     def damaged_force(self, stress: np.ndarray, differences: np.ndarray, c: np.ndarray,
                       damage: np.ndarray) -> np.ndarray:

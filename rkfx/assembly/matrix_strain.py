@@ -63,7 +63,7 @@ class LocalMatrixStrain(LocalNodes):
         B: The owned points' rows over the local unknowns, shape ``(3 num_owned, 2 num_local)``.
         BT: The owned unknowns' rows over the local points' Voigt rows (owned points first).
         volume: V_L of every local point.
-        point_halo, node_halo: The exchanges of the ghost points' loads and the ghost nodes' force.
+        row_halo, node_halo: The exchanges of the ghost points' loads and the ghost nodes' force.
     """
 
     nodes: np.ndarray
@@ -73,7 +73,7 @@ class LocalMatrixStrain(LocalNodes):
     B: sp.csr_matrix
     BT: sp.csr_matrix
     volume: np.ndarray
-    point_halo: Halo
+    row_halo: Halo
     node_halo: Halo
     stabilization = None  # plain strains: ``DamageForce`` calls ``strain`` and ``force``
 
@@ -91,11 +91,7 @@ class LocalMatrixStrain(LocalNodes):
         owned points. Collective."""
         load = np.empty((len(self.volume), 3))
         np.multiply(stress, self.volume[:len(self.points), None], out=load[:len(self.points)])
-        self.point_halo.exchange(load)
-        f = np.empty(2 * self.num_local)
-        f[:2 * len(self.owned_nodes)] = self.BT @ load.ravel()
-        self.node_halo.exchange(f.reshape(-1, 2))
-        return f
+        return self._exchanged(load, lambda out: np.copyto(out, self.BT @ load.ravel()))
 
 
 def point_parts(B: sp.csr_matrix, part: np.ndarray) -> np.ndarray:
