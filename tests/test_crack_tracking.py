@@ -5,7 +5,7 @@ import pytest
 from rkfx.fracture.tracking import tracking
 from rkfx.materials.elasticity import principal_direction
 from rkfx.errors import InputError
-from rkfx.geometry.particles import structured
+from rkfx.geometry.particles import graded, structured
 
 
 @pytest.fixture(scope="module")
@@ -51,12 +51,13 @@ def test_candidates_lie_ahead_of_the_parent():
     horizontal = np.array([[0.0, 1.0]])
     for forward, expect in ((True, [1, 2, 3]), (False, [-3, -2, -1, 1, 2, 3])):
         track = tracking(p.x, p.spacing, 0.3, radius=3.5, forward=forward)
-        cand, by = track.candidates(np.array([centre]), horizontal, parents)
+        cand, by = track.candidates(np.array([centre]), horizontal, parents[[centre]])
         assert sorted(np.round((p.x[cand, 0] - p.x[centre, 0]) / 0.1).astype(int)) == expect
     track = tracking(p.x, p.spacing, 0.3, radius=3.5)
-    assert len(track.candidates(np.array([centre]), horizontal, np.full(p.num_nodes, -1))[0]) == 6
+    assert len(track.candidates(np.array([centre]), horizontal, np.array([-1]))[0]) == 6
     # Two initiating particles: each candidate records the first that admits it.
-    cand, by = track.candidates(np.array([centre, 61]), np.array([[0.0, 1.0], [0.0, 1.0]]), parents)
+    cand, by = track.candidates(np.array([centre, 61]), np.array([[0.0, 1.0], [0.0, 1.0]]),
+                                parents[[centre, 61]])
     assert by[cand == 62][0] == centre and by[cand == 60][0] == 61
 
 
@@ -83,3 +84,29 @@ def test_principal_direction():
     stress = np.column_stack([s1 * c**2 + s2 * s**2, s1 * s**2 + s2 * c**2, (s1 - s2) * s * c])
     d = principal_direction(stress)
     assert np.allclose(np.abs(np.sum(d * np.column_stack([c, s]), axis=1)), 1.0)
+
+
+def test_a_rank_keeps_the_neighbour_sets_that_reach_its_particles():
+    """``near``: the neighbour sets of the particles with one of ``points`` among their
+    neighbours, equal to the whole build's; the candidates among ``points`` of any initiations
+    are the whole tracking's, with the same parents."""
+    p = graded(np.linspace(0.0, 1.0, 23), np.linspace(0.0, 1.0, 19) ** 1.3)  # graded: radii differ
+    whole = tracking(p.x, p.spacing, 0.4, radius=2.5)
+    points = np.flatnonzero(p.x[:, 0] < 0.37)
+    part = whole.near(points)
+    reach = {i for i in range(p.num_nodes)
+             if np.isin(whole.indices[whole.indptr[i]:whole.indptr[i + 1]], points).any()}
+    assert reach - set(points.tolist()) and set(part.rows.tolist()) == reach | set(points.tolist())
+    for i in range(p.num_nodes):
+        mine = part.indices[part.indptr[i]:part.indptr[i + 1]]
+        expect = whole.indices[whole.indptr[i]:whole.indptr[i + 1]] if i in part.rows else []
+        assert sorted(mine) == sorted(expect), i
+    rng = np.random.default_rng(3)
+    nodes = np.sort(rng.choice(p.num_nodes, 40, replace=False))
+    t = rng.uniform(0, np.pi, 40)
+    normals, parents = np.column_stack([np.cos(t), np.sin(t)]), rng.integers(-1, p.num_nodes, 40)
+    a, by_a = whole.candidates(nodes, normals, parents)
+    b, by_b = part.candidates(nodes, normals, parents)
+    keep = np.isin(a, points)
+    assert keep.any() and np.array_equal(a[keep], b[np.isin(b, points)])
+    assert np.array_equal(by_a[keep], by_b[np.isin(b, points)])

@@ -114,6 +114,18 @@ def _fill(x, a, points, origin, cell, nx, ny, start, order, indptr, indices):
                      indices[indptr[p]:indptr[p + 1]], True)
 
 
+def covered(x: np.ndarray, a: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Whether the support of some node J covers each point p, |p - x_J| < a_J (2-D), shape
+    ``(num_points,)`` bool; ``x``, ``a``, ``points`` as for ``support_neighbours``."""
+    x = np.ascontiguousarray(x, dtype=np.float64)
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
+    if len(x) == 0:
+        return np.zeros(len(points), bool)
+    g = cell_grid(x, a, points)
+    return count_covering(x, a, points, g.origin, g.cell, *g.shape, g.start, g.order) > 0
+
+
 def support_neighbours(x: np.ndarray, a: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Nodes J with |p - x_J| < a_J for every point p.
 

@@ -116,7 +116,7 @@ class DamageHistory:
         with ``normal``; whether any was not allowed before."""
         if self.track is None or new.size == 0:
             return False
-        cand, by = self.track.candidates(new, normal[new], parent)
+        cand, by = self.track.candidates(new, normal[new], parent[new])
         fresh = ~allowed[cand]
         allowed[cand] = True
         parent[cand[fresh]] = by[fresh]

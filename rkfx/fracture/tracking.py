@@ -31,12 +31,13 @@ spreads by 8.5% with 3.5 h and by 21% with 2.5 h). Keeping the neighbours that f
 when another particle allows them (a strict prevention zone) arrests Kalthoff's crack within
 a few millimetres, so the zone only withholds candidacy.
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from functools import cached_property
 
 import numpy as np
 
 from rkfx.errors import InputError
-from rkfx.approximation.neighbours import support_neighbours
+from rkfx.approximation.neighbours import covered, support_neighbours
 
 
 @dataclass(frozen=True)
@@ -45,39 +46,79 @@ class Tracking:
 
     Attributes:
         x: Particle positions, shape ``(n, 2)`` [m].
-        indptr, indices: The neighbour sets N_L as CSR (self excluded; indices int32).
+        spacing: Nodal spacing h_L, shape ``(n,)`` [m].
         tol: Tolerance of (4.22), in (0, 1].
         seeds: Particles that may always initiate, shape ``(n,)`` bool.
+        radius: Neighbourhood radius in spacings.
         enabled: ``False`` lets every particle damage.
         forward: Candidates only ahead of their particle (away from its parent).
+        rows: The particles whose neighbour sets are kept, sorted (``None``: all). A rank of a
+            distributed run keeps those of the particles near its own (``near``).
     """
 
     x: np.ndarray
-    indptr: np.ndarray
-    indices: np.ndarray
+    spacing: np.ndarray
     tol: float
     seeds: np.ndarray
+    radius: float = 3.5
     enabled: bool = True
     forward: bool = True
+    rows: np.ndarray | None = None
+
+    @cached_property
+    def neighbours(self) -> tuple[np.ndarray, np.ndarray]:
+        """The neighbour sets N_L of ``rows`` (the others empty), built on first use: CSR
+        ``(indptr, indices)`` over all particles, shapes ``(n + 1,)`` int64 and ``(nnz,)`` int32;
+        N_L holds the particles I != L with |x_L - x_I| < radius h_I."""
+        n = len(self.x)
+        rows = np.arange(n) if self.rows is None else self.rows
+        ptr, idx = support_neighbours(self.x, self.radius * np.asarray(self.spacing, float), self.x[rows])
+        keep = idx != np.repeat(rows, np.diff(ptr))
+        counts = np.zeros(n, np.int64)
+        counts[rows] = np.add.reduceat(keep.astype(np.int64), ptr[:-1]) if len(rows) else 0
+        indptr = np.zeros(n + 1, np.int64)
+        np.cumsum(counts, out=indptr[1:])
+        return indptr, idx[keep]
+
+    @property
+    def indptr(self) -> np.ndarray:
+        return self.neighbours[0]
+
+    @property
+    def indices(self) -> np.ndarray:
+        return self.neighbours[1]
+
+    def near(self, points: np.ndarray) -> "Tracking":
+        """This tracking with the neighbour sets of only the particles that have one of
+        ``points`` among their neighbours (and of ``points``): the initiations that can make
+        one of ``points`` a candidate."""
+        points = np.asarray(points, np.int64)
+        a = self.radius * np.asarray(self.spacing, float)
+        rows = np.flatnonzero(covered(self.x[points], a[points], self.x))
+        return replace(self, rows=np.union1d(rows, points))
 
     def candidates(self, nodes: np.ndarray, normals: np.ndarray,
                    parents: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Neighbours of the particles ``nodes`` (crack normals ``normals``) that satisfy (4.22)
-        and, with ``forward``, lie ahead of them: ``parents`` holds each node's parent (-1: none).
+        and, with ``forward``, lie ahead of them: ``parents`` holds the parent of each of
+        ``nodes`` (-1: none), shape ``(len(nodes),)``.
 
         Returns:
             (candidates, by): the distinct candidates and, for each, the first of ``nodes``
             that admits it (its parent).
         """
         nodes = np.asarray(nodes, np.int64)
-        counts = self.indptr[nodes + 1] - self.indptr[nodes]
+        indptr, indices = self.neighbours
+        counts = indptr[nodes + 1] - indptr[nodes]
         rows = np.repeat(np.arange(len(nodes)), counts)
-        cols = np.concatenate([self.indices[self.indptr[i]:self.indptr[i + 1]] for i in nodes]) \
-            if len(nodes) else np.empty(0, self.indices.dtype)
+        cols = np.concatenate([indices[indptr[i]:indptr[i + 1]] for i in nodes]) \
+            if len(nodes) else np.empty(0, indices.dtype)
         d = self.x[cols] - self.x[nodes[rows]]
         ok = np.abs(np.sum(normals[rows] * d, axis=1)) < self.tol * np.linalg.norm(d, axis=1)
         if self.forward and parents is not None:
-            parent = np.asarray(parents)[nodes]
+            parent = np.asarray(parents, np.int64)
+            if parent.shape != nodes.shape:
+                raise InputError(f"parents has shape {parent.shape}; expected one per node, {nodes.shape}")
             has = parent >= 0
             back = np.zeros((len(nodes), 2))
             back[has] = self.x[nodes[has]] - self.x[parent[has]]
@@ -119,8 +160,5 @@ def tracking(x: np.ndarray, spacing: np.ndarray, tol: float, seeds: np.ndarray |
             mask |= s
         else:
             mask[s.astype(np.int64)] = True
-    ptr, idx = support_neighbours(x, radius * np.asarray(spacing, float), x)
-    keep = idx != np.repeat(np.arange(n), np.diff(ptr))
-    new_ptr = np.zeros(n + 1, np.int64)
-    np.cumsum(np.add.reduceat(keep.astype(np.int64), ptr[:-1]) if n else [], out=new_ptr[1:])
-    return Tracking(x, new_ptr, idx[keep], float(tol), mask, bool(enabled), bool(forward))
+    return Tracking(x, np.ascontiguousarray(spacing, float), float(tol), mask, float(radius), bool(enabled),
+                    bool(forward))

@@ -156,6 +156,8 @@ class DamageForce:
         if model.num_points != op.num_nodes:
             raise InputError(f"damage model has {model.num_points} points for {op.num_nodes} particles")
         self.op, self.model, self.field, self.track, self.dt = op, model, field, track, float(dt)
+        if track is not None and track.enabled:
+            track.neighbours  # noqa: B018 - built at set-up, not at the first initiation
         elastic = model.material.elastic
         self.c = np.ascontiguousarray(elastic.D())
         self.nu_zz = elastic.out_of_plane_ratio
@@ -199,7 +201,7 @@ class DamageForce:
         f.damaged[new] = True
         f.initiation_time[new] = f.clock[0]
         if self.track is not None and self.track.enabled:
-            cand, by = self.track.candidates(new, f.normal[new], f.parent)
+            cand, by = self.track.candidates(new, f.normal[new], f.parent[new])
             fresh = ~f.allowed[cand]
             f.parent[cand[fresh]] = by[fresh]
             f.allowed[cand] = True

@@ -8,10 +8,12 @@ on the rank's local vectors as it would serially; per step the ranks exchange:
 
 * the loads of the rows that couple to another rank's nodes, and the internal force at the
   ghost nodes (two neighbour-only halo exchanges, ``rkfx.parallel.halo``);
-* when a particle initiates anywhere, the new crack particles and their normals (one small
-  all-gather), so that every rank marks the same tracking candidates (4.22), in the serial
-  order, also across the partition boundaries; how many initiated on each rank is one
-  all-gather of a count per step (with tracking on);
+* when a particle initiates anywhere, the new crack particles with their normals and parents
+  (one small all-gather), so that every rank marks among its own particles the tracking
+  candidates (4.22) a serial run marks, with the same parents, also across the partition
+  boundaries; each rank keeps only the neighbour sets that reach its particles
+  (``Tracking.near``); how many initiated on each rank is one all-gather of a count per step
+  (with tracking on);
 * the energies and the history samples (all-reduces of a few numbers).
 
 The constraint rows are replicated (the columns of G are ghosts everywhere), so every rank
@@ -64,35 +66,37 @@ def restricted(model: DamageModel, points: np.ndarray) -> DamageModel:
 
 
 class RankDamageForce(DamageForce):
-    """``DamageForce`` of one rank's points: initiations are gathered over the ranks, so the
-    tracking state (which particles may initiate, and their parents) is the same everywhere."""
+    """``DamageForce`` of one rank's points. Initiations are gathered over the ranks with their
+    parents, and every rank marks the candidates among its own points of those initiations
+    whose neighbour sets reach them (``Tracking.near``), so each point's admission and parent
+    are the serial ones."""
 
     def __init__(self, op: LocalNodes, model: DamageModel, local_model: DamageModel, field,
                  track: Tracking | None, dt: float, comm):
-        super().__init__(op, local_model, field, track, dt)
-        self.whole, self.comm = model, comm
-        n = model.num_points
         tracked = track is not None and track.enabled
-        self.allowed = track.seeds.copy() if tracked else np.ones(n, bool)
-        self.parent = np.full(n, -1, np.int64)
+        super().__init__(op, local_model, field, track.near(op.points) if tracked else track, dt)
+        self.whole, self.comm = model, comm
         self.tracked = tracked
+        if tracked:
+            field.allowed[:] = track.seeds[op.points]
         self._counts = np.zeros(comm.size, np.int64)
         self._one = np.zeros(1, np.int64)
 
-    def _gathered(self, ids: np.ndarray, normals: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-        """The initiations of every rank in this evaluation, rank by rank (ids, normals), or
-        ``None`` if there are none: an all-gather of the counts, then one of (id, n_x, n_y)
-        triples as doubles (ids below 2^53 are exact). Collective."""
-        self._one[0] = len(ids)
+    def _gathered(self, new: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """The initiations of every rank in this evaluation, rank by rank (ids, normals,
+        parents), or ``None`` if there are none: an all-gather of the counts, then one of
+        (id, n_x, n_y, parent) quadruples as doubles (ids below 2^53 are exact). Collective."""
+        self._one[0] = len(new)
         self.comm.Allgather(self._one, self._counts)
         total = int(self._counts.sum())
         if total == 0:
             return None
-        mine = np.empty((len(ids), 3))
-        mine[:, 0], mine[:, 1:] = ids, normals
-        every = np.empty((total, 3))
-        self.comm.Allgatherv(mine, [every, 3 * self._counts])
-        return every[:, 0].astype(np.int64), np.ascontiguousarray(every[:, 1:])
+        f = self.field
+        mine = np.empty((len(new), 4))
+        mine[:, 0], mine[:, 1:3], mine[:, 3] = self.op.points[new], f.normal[new], f.parent[new]
+        every = np.empty((total, 4))
+        self.comm.Allgatherv(mine, [every, 4 * self._counts])
+        return every[:, 0].astype(np.int64), np.ascontiguousarray(every[:, 1:3]), every[:, 3].astype(np.int64)
 
     def _initiate_all(self, new: np.ndarray) -> None:
         f, points = self.field, self.op.points
@@ -102,19 +106,18 @@ class RankDamageForce(DamageForce):
             f.initiation_time[new] = f.clock[0]
         if not self.tracked:
             return
-        gathered = self._gathered(points[new], f.normal[new])
+        gathered = self._gathered(new)
         if gathered is None:
             return
-        ids, normals = gathered
+        ids, normals, parents = gathered
         order = np.argsort(ids, kind="stable")  # ascending, as serially
-        cand, by = self.track.candidates(ids[order], normals[order], self.parent)
-        fresh = ~self.allowed[cand]
-        self.parent[cand[fresh]] = by[fresh]
-        self.allowed[cand] = True
+        cand, by = self.track.candidates(ids[order], normals[order], parents[order])
         local = self.op.node_of[cand]  # points are the owned particles, the first local nodes
         mine = (local >= 0) & (local < len(points))
-        f.allowed[local[mine]] = True
-        f.parent[local[mine]] = self.parent[cand[mine]]
+        local, by = local[mine], by[mine]
+        fresh = ~f.allowed[local]
+        f.parent[local[fresh]] = by[fresh]
+        f.allowed[local] = True
 
 
 class RankDamage(DamageDynamics):
@@ -138,12 +141,10 @@ class RankDamage(DamageDynamics):
         self.op, self.damage_model = local, restricted(model, points)
         self.field = damage_field(self.damage_model, None, dt)
         self.force = RankDamageForce(local, model, self.damage_model, self.field, track, dt, comm)
-        self.field.allowed[:] = self.force.allowed[points]
         essential = [Constraint(_columns(c.G, local), c.displacement, c.velocity) for c in constraints]
         f_ext = None if external_force is None else (lambda t: np.asarray(external_force(t))[dofs])
         ExplicitDynamics.__init__(self, np.asarray(mass)[dofs], self.force, dt, f_ext, essential,
-                                  self.field.arrays | {"allowed_all": self.force.allowed,
-                                                       "parent_all": self.force.parent})
+                                  self.field.arrays)
         self.share = MpiShare(comm, local.owned_dofs)
         self.comm, self.num_points, self.num_whole_nodes = comm, op.num_nodes, len(mass) // 2
 
