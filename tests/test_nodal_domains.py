@@ -4,7 +4,7 @@ import pytest
 
 from conftest import l_shape, unit_square
 from rkfx.geometry.nodal_domains import nodal_domains
-from rkfx.geometry.particles import graded, geometric_spacing, particles, structured
+from rkfx.geometry.particles import graded, geometric_spacing, structured
 
 
 @pytest.mark.parametrize("make, area", [(lambda: unit_square(0.08), 1.0), (lambda: l_shape(0.1), 3.0),
@@ -16,24 +16,6 @@ def test_areas_sum_to_domain_area(make, area):
     assert np.all(d.area > 0) and np.all(d.subcell_area > 0)
     assert abs(d.area.sum() - area) <= 1e-13 * area
     assert np.allclose(np.bincount(d.subcell_node, d.subcell_area, p.num_nodes), d.area, rtol=1e-13)
-
-
-@pytest.mark.parametrize("nx, ny", [(2, 2), (2, 5), (7, 2), (9, 6)])
-def test_a_grid_is_the_validated_triangulation_of_its_nodes(nx, ny):
-    """``graded`` writes the boundary of its grid directly; it is what ``particles`` finds by
-    counting triangles per edge: the same sides in the same order, orientation and tags, and
-    the same edge tables, built on first use."""
-    xs, ys = geometric_spacing(2.0, nx, 1.3), np.linspace(0.0, 1.0, ny) ** 1.5
-    g = graded(xs, ys)
-    node = np.arange(nx * ny).reshape(ny, nx)
-    sides = {"bottom": node[0], "right": node[:, -1], "top": node[-1], "left": node[:, 0]}
-    p = particles(g.x, g.triangles, {k: np.column_stack([v[:-1], v[1:]]) for k, v in sides.items()}, g.spacing)
-    assert "_edge_tables" not in g.__dict__
-    for name in ("x", "spacing", "triangles", "boundary_edges", "boundary_tags", "edges", "triangle_edges"):
-        a, b = getattr(g, name), getattr(p, name)
-        assert a.dtype == b.dtype and np.array_equal(a, b), name
-    assert g.boundary_names == p.boundary_names
-    assert np.array_equal(g.boundary_nodes("left"), node[:, 0])
 
 
 def test_cells_are_closed_and_boundary_is_the_perimeter():
@@ -177,7 +159,7 @@ def test_cell_rows_come_in_node_order_without_a_reordering_copy(monkeypatch):
     for name in ("indptr", "indices", "data"):
         assert np.array_equal(getattr(one.cell, name), getattr(many.cell, name)), name
     perm = np.random.default_rng(1).permutation(len(p.triangles))
-    q = replace(p, triangles=p.triangles[perm])  # its edge tables are rebuilt from them
+    q = replace(p, triangles=p.triangles[perm], triangle_edges=p.triangle_edges[perm])
     shuffled = quadrature.smoothed_gradients(q, rk, nodal_domains(q))
     assert copies == [p.num_nodes]
     for k in range(2):

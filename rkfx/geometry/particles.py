@@ -7,7 +7,6 @@ the conforming nodal domains (``rkfx.geometry.nodal_domains``). Factories: ``str
 ``rkfx.geometry.gmsh_nodes.from_gmsh`` for gmsh geometry.
 """
 from dataclasses import dataclass, field
-from functools import cached_property
 
 import numba
 import numpy as np
@@ -51,9 +50,8 @@ class Particles(NamedBoundary):
             shape ``(num_boundary_edges, 2)``.
         boundary_tags: Tag of each boundary edge, shape ``(num_boundary_edges,)``; 0 = untagged.
         boundary_names: Name -> tag.
-
-    The edge tables ``edges`` and ``triangle_edges`` are built on first use (the grid cells of
-    the explicit runs never read them).
+        edges: Unique triangulation edges (i < j), shape ``(num_edges, 2)``.
+        triangle_edges: Edge index of side k = (v_k, v_k+1) of each triangle, shape ``(num_triangles, 3)``.
     """
 
     x: np.ndarray
@@ -62,21 +60,8 @@ class Particles(NamedBoundary):
     boundary_edges: np.ndarray
     boundary_tags: np.ndarray
     boundary_names: dict[str, int] = field(default_factory=dict)
-
-    @cached_property
-    def _edge_tables(self) -> tuple[np.ndarray, np.ndarray]:
-        edges, triangle_edges, _ = unique_edges(self.triangles, self.num_nodes)
-        return edges, triangle_edges
-
-    @property
-    def edges(self) -> np.ndarray:
-        """Unique triangulation edges (i < j) ordered by i, shape ``(num_edges, 2)``."""
-        return self._edge_tables[0]
-
-    @property
-    def triangle_edges(self) -> np.ndarray:
-        """Edge index of side k = (v_k, v_k+1) of each triangle, shape ``(num_triangles, 3)``."""
-        return self._edge_tables[1]
+    edges: np.ndarray | None = None
+    triangle_edges: np.ndarray | None = None
 
     @property
     def num_nodes(self) -> int:
@@ -218,9 +203,7 @@ def particles(x: np.ndarray, triangles: np.ndarray, tagged_edges: dict[str, np.n
     if spacing is None:
         spacing = _mean_edge_length(x, edges, n)
     spacing = np.ascontiguousarray(np.broadcast_to(np.asarray(spacing, float), (n,)))
-    p = Particles(x, spacing, tri, bedges, tags, names)
-    p.__dict__["_edge_tables"] = (edges, tri_edges)  # built already: the cache of the property
-    return p
+    return Particles(x, spacing, tri, bedges, tags, names, edges, tri_edges)
 
 
 def _mean_edge_length(x, edges, n):
@@ -250,21 +233,15 @@ def graded(xs: np.ndarray, ys: np.ndarray) -> Particles:
     a, b = node[:-1, :-1], node[:-1, 1:]
     c, d = node[1:, 1:], node[1:, :-1]
     tri = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
-    # The boundary sides, in the order and orientation ``particles`` finds them (by triangle,
-    # then side (v_k, v_k+1)): of (a, b, c) the bottom (k = 0) and right (k = 1) ones, of
-    # (a, c, d) the top (k = 1) and left (k = 2) ones.
-    j, i = np.divmod(np.arange((nx - 1) * (ny - 1)), nx - 1)
-    tag_of = np.zeros((2, len(j), 3), np.int64)
-    names = {"bottom": 1, "right": 2, "top": 3, "left": 4}
-    tag_of[0, j == 0, 0], tag_of[0, i == nx - 2, 1] = names["bottom"], names["right"]
-    tag_of[1, j == ny - 2, 1], tag_of[1, i == 0, 2] = names["top"], names["left"]
-    t_b, k_b = np.nonzero(tag_of.reshape(-1, 3))
-    bedges = np.column_stack([tri[t_b, k_b], tri[t_b, (k_b + 1) % 3]])
+    def side(ids):
+        return np.column_stack([ids[:-1], ids[1:]])
+    edges = {"bottom": side(node[0]), "right": side(node[:, -1]),
+             "top": side(node[-1]), "left": side(node[:, 0])}
     def local(c):
         d = np.diff(c)
         return np.maximum(np.r_[d, d[-1]], np.r_[d[0], d])
     spacing = np.maximum.outer(local(ys), local(xs)).ravel()
-    return Particles(x, spacing, tri, bedges, tag_of.reshape(-1, 3)[t_b, k_b], names)
+    return particles(x, tri, edges, spacing)
 
 
 def structured(lx: float, ly: float, nx: int, ny: int, origin: tuple[float, float] = (0.0, 0.0)) -> Particles:
