@@ -114,16 +114,22 @@ def _fill(x, a, points, origin, cell, nx, ny, start, order, indptr, indices):
                      indices[indptr[p]:indptr[p + 1]], True)
 
 
-def covered(x: np.ndarray, a: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """Whether the support of some node J covers each point p, |p - x_J| < a_J (2-D), shape
-    ``(num_points,)`` bool; ``x``, ``a``, ``points`` as for ``support_neighbours``."""
+def _covering_counts(x: np.ndarray, a: np.ndarray, points: np.ndarray):
+    """The 2-D inputs as contiguous float arrays, their cell grid and the number of nodes whose
+    support covers each point: ``(x, a, points, grid, counts)``."""
     x = np.ascontiguousarray(x, dtype=np.float64)
     a = np.ascontiguousarray(a, dtype=np.float64)
     points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
-    if len(x) == 0:
-        return np.zeros(len(points), bool)
     g = cell_grid(x, a, points)
-    return count_covering(x, a, points, g.origin, g.cell, *g.shape, g.start, g.order) > 0
+    return x, a, points, g, count_covering(x, a, points, g.origin, g.cell, *g.shape, g.start, g.order)
+
+
+def covered(x: np.ndarray, a: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Whether the support of some node J covers each point p, |p - x_J| < a_J (2-D), shape
+    ``(num_points,)`` bool; ``x``, ``a``, ``points`` as for ``support_neighbours``."""
+    if len(x) == 0:
+        return np.zeros(len(np.reshape(points, (-1, 2))), bool)
+    return _covering_counts(x, a, points)[-1] > 0
 
 
 def support_neighbours(x: np.ndarray, a: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -142,11 +148,7 @@ def support_neighbours(x: np.ndarray, a: np.ndarray, points: np.ndarray) -> tupl
         from rkfx.approximation.neighbours3d import support_neighbours_3d  # noqa: PLC0415 (imports this module)
 
         return support_neighbours_3d(x, a, points)
-    x = np.ascontiguousarray(x, dtype=np.float64)
-    a = np.ascontiguousarray(a, dtype=np.float64)
-    points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
-    g = cell_grid(x, a, points)
-    counts = count_covering(x, a, points, g.origin, g.cell, *g.shape, g.start, g.order)
+    x, a, points, g, counts = _covering_counts(x, a, points)
     indptr = np.zeros(len(points) + 1, np.int64)
     np.cumsum(counts, out=indptr[1:])
     indices = np.empty(indptr[-1], np.int32)
