@@ -31,6 +31,7 @@ import numpy as np
 
 from rkfx.errors import InputError
 from rkfx.fracture import damage as dm
+from rkfx.fracture.tracking import admit
 
 DAMAGE_UPDATES = ("implicit", "impl-ex")
 
@@ -116,11 +117,7 @@ class DamageHistory:
         with ``normal``; whether any was not allowed before."""
         if self.track is None or new.size == 0:
             return False
-        cand, by = self.track.candidates(new, normal[new], parent[new])
-        fresh = ~allowed[cand]
-        allowed[cand] = True
-        parent[cand[fresh]] = by[fresh]
-        return bool(fresh.any())
+        return admit(*self.track.candidates(new, normal[new], parent[new]), allowed, parent)
 
     def commit(self) -> None:
         """The last residual's trial damage (and the step's admissions) become the committed ones;

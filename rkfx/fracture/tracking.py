@@ -38,6 +38,7 @@ import numpy as np
 
 from rkfx.errors import InputError
 from rkfx.approximation.neighbours import covered, support_neighbours
+from rkfx.approximation.sparse_rows import ranges
 
 
 @dataclass(frozen=True)
@@ -73,9 +74,10 @@ class Tracking:
         n = len(self.x)
         rows = np.arange(n) if self.rows is None else self.rows
         ptr, idx = support_neighbours(self.x, self.radius * np.asarray(self.spacing, float), self.x[rows])
-        keep = idx != np.repeat(rows, np.diff(ptr))
+        row = np.repeat(np.arange(len(rows)), np.diff(ptr))
+        keep = idx != rows[row]
         counts = np.zeros(n, np.int64)
-        counts[rows] = np.add.reduceat(keep.astype(np.int64), ptr[:-1]) if len(rows) else 0
+        counts[rows] = np.bincount(row[keep], minlength=len(rows))
         indptr = np.zeros(n + 1, np.int64)
         np.cumsum(counts, out=indptr[1:])
         return indptr, idx[keep]
@@ -111,8 +113,7 @@ class Tracking:
         indptr, indices = self.neighbours
         counts = indptr[nodes + 1] - indptr[nodes]
         rows = np.repeat(np.arange(len(nodes)), counts)
-        cols = np.concatenate([indices[indptr[i]:indptr[i + 1]] for i in nodes]) \
-            if len(nodes) else np.empty(0, indices.dtype)
+        cols = indices[ranges(indptr[nodes], counts)]
         d = self.x[cols] - self.x[nodes[rows]]
         ok = np.abs(np.sum(normals[rows] * d, axis=1)) < self.tol * np.linalg.norm(d, axis=1)
         if self.forward and parents is not None:
@@ -133,6 +134,15 @@ def check_tracking(tol: float, radius: float) -> None:
         raise InputError(f"tracking tolerance tol = {tol!r} must lie in (0, 1]; the seed uses 0.3-0.5")
     if not radius >= 1.0:
         raise InputError(f"tracking radius = {radius!r} spacings must be >= 1 (2.5 reaches the (1, 2) neighbours)")
+
+
+def admit(cand: np.ndarray, by: np.ndarray, allowed: np.ndarray, parent: np.ndarray) -> bool:
+    """Allow the candidates ``cand`` (distinct, from ``Tracking.candidates``) in place; those not
+    allowed before take their admitting particle ``by`` as parent. Whether any was new."""
+    fresh = ~allowed[cand]
+    parent[cand[fresh]] = by[fresh]
+    allowed[cand] = True
+    return bool(fresh.any())
 
 
 def tracking(x: np.ndarray, spacing: np.ndarray, tol: float, seeds: np.ndarray | None = None,

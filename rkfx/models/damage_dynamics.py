@@ -54,7 +54,7 @@ from typing import Protocol
 import numba
 import numpy as np
 
-from rkfx.fracture.tracking import Tracking
+from rkfx.fracture.tracking import Tracking, admit
 from rkfx.fracture.damage import DamageModel, crack_opening, dissipation_density, initiate
 from rkfx.materials.damage_law import damage_kernel, strain_kernel
 from rkfx.errors import InputError
@@ -201,10 +201,7 @@ class DamageForce:
         f.damaged[new] = True
         f.initiation_time[new] = f.clock[0]
         if self.track is not None and self.track.enabled:
-            cand, by = self.track.candidates(new, f.normal[new], f.parent[new])
-            fresh = ~f.allowed[cand]
-            f.parent[cand[fresh]] = by[fresh]
-            f.allowed[cand] = True
+            admit(*self.track.candidates(new, f.normal[new], f.parent[new]), f.allowed, f.parent)
 
 
 class DamageDynamics(ExplicitDynamics):

@@ -31,7 +31,7 @@ import numpy as np
 from rkfx.assembly.local_strain import LocalNodes, local_smeared_strain
 from rkfx.assembly.matrix_strain import MatrixStrain, local_matrix_strain
 from rkfx.fracture.damage import DamageModel, initiate
-from rkfx.fracture.tracking import Tracking
+from rkfx.fracture.tracking import Tracking, admit
 from rkfx.models.damage_dynamics import DamageDynamics, DamageForce, damage_field
 from rkfx.solvers.central_difference import Constraint, ExplicitDynamics
 
@@ -114,10 +114,7 @@ class RankDamageForce(DamageForce):
         cand, by = self.track.candidates(ids[order], normals[order], parents[order])
         local = self.op.node_of[cand]  # points are the owned particles, the first local nodes
         mine = (local >= 0) & (local < len(points))
-        local, by = local[mine], by[mine]
-        fresh = ~f.allowed[local]
-        f.parent[local[fresh]] = by[fresh]
-        f.allowed[local] = True
+        admit(local[mine], by[mine], f.allowed, f.parent)
 
 
 class RankDamage(DamageDynamics):
