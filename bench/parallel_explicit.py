@@ -49,7 +49,7 @@ def main() -> None:
         share_cores(comm)
     reuse_freed_memory()  # large temporaries reuse freed pages (rkfx.memory)
     warm_up()
-    k.run(methods=("rkpm",), h=k.spacings([40]), unregularized_h=[], no_tracking_h=[], fem_h=[],
+    k.run(methods=("rkpm",), h=k.spacings([40]), unregularized_h=[], no_tracking_h=[], fem_h=[], nonlocal_h=[],
           t_end=5e-6)  # compile the step kernels
     prm = {name: spec.default for name, spec in k.PARAMS.items()}
     material = dm.DamageMaterial(prm["E"], prm["nu"], prm["ft"], prm["GF"], "strain")

@@ -98,15 +98,15 @@ def test_dissipation_is_objective_with_regularization_only(quick):
 
 def test_cli_writes_metrics_runs_fem_and_rejects_bad_input(tmp_path, capsys):
     out = tmp_path / "b"
-    assert cb.main(["--method", "rkpm", "--set", "h=1.6e-3", "unregularized_h=1.6e-3", "t_end=1e-5",
-                    "--out", str(out)]) == 0
+    assert cb.main(["--method", "rkpm", "--set", "h=1.6e-3", "unregularized_h=1.6e-3", "nonlocal_h=8e-4",
+                    "t_end=1e-5", "--out", str(out)]) == 0
     data = json.loads((out / "results.json").read_text())
     run = next(r for r in data["runs"] if r["method"] == "rkpm-dpm h=0.0016")
     assert {"branches", "branch_x", "tip_x", "dissipated_end", "energy_error"} <= set(run["errors"])
     assert {"time_us", "dissipated", "tip_x"} <= set(run["series"])
     summ = next(r for r in data["runs"] if r["info"].get("of") == "rkpm-dpm")
     assert "dissipation_change_fine" in summ["errors"] and set(summ["series"]["branches"]) == {"0.0016"}
-    for f in ("cracks.png", "damage.png", "damage_unregularized.png", "dissipation.png"):
+    for f in ("cracks.png", "damage.png", "damage_unregularized.png", "cracks_nonlocal.png", "dissipation.png"):
         assert (out / f).is_file()
     # The crack-band finite elements: same metrics and figures.
     assert cb.main(["--method", "fem", "--set", "fem_h=1.6e-3", "t_end=2e-5", "--out", str(tmp_path / "f")]) == 0

@@ -68,3 +68,11 @@ def test_a_resume_reads_runs_stored_under_an_alias(tmp_path):
     assert _cli.check_resume(tmp_path, stamp, False, kalthoff.PARAMS)
     with pytest.raises(ParameterError, match=r"h = .* \(now "):
         _cli.check_resume(tmp_path, {**stamp, "params": {**stamp["params"], "h": [1e-3]}}, False, kalthoff.PARAMS)
+
+
+def test_none_empties_a_list_and_an_empty_value_stays_an_error():
+    """``--set nonlocal_h=none`` skips a study; ``--set h=`` is still refused in one line."""
+    assert _cli.coerce("nonlocal_h", "none", [8e-4]) == []
+    assert _cli.coerce("nonlocal_h", " None ", [8e-4]) == []
+    with pytest.raises(_cli.ParameterError, match="comma-separated list"):
+        _cli.coerce("h", "", [8e-4])

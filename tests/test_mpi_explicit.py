@@ -127,3 +127,16 @@ def test_branching_crack_band_fem_on_two_ranks_is_the_serial_run(tmp_path):
     serial = runs(tmp_path / "serial")
     assert any(r["series"].get("damaged_index") for r in serial.values())
     assert_same_runs(serial, runs(tmp_path / "ranks"))
+
+
+def test_nonlocal_branching_on_ranks_is_the_serial_run(tmp_path):
+    """The nonlocal equivalent strain on ranks (the averages read every rank's strains through
+    one all-gather per step): the same damaged particles, damage and openings on 2 and 3 ranks."""
+    args = ["-m", "rkfx.cases.crack_branching", "--method", "rkpm", "--set", "h=1.6e-3", "unregularized_h=1.6e-3",
+            "nonlocal_h=1.6e-3", "nonlocal_radius=3.2e-3", "t_end=5e-5"]
+    mpiexec(1, *args, "--out", str(tmp_path / "serial"))
+    serial = runs(tmp_path / "serial")
+    assert serial["rkpm-dpm-nonlocal h=0.0016"]["series"]["damaged_index"]
+    for ranks in (2, 3):
+        mpiexec(ranks, *args, "--out", str(tmp_path / f"ranks{ranks}"))
+        assert_same_runs(serial, runs(tmp_path / f"ranks{ranks}"))

@@ -147,6 +147,7 @@ ROWS: list[Row] = [
     Row("empty list", "mandel", ("--set", "t_D=")),
     Row("list with a non-number", "mandel", ("--set", "t_D=0.1,soon")),
     Row("list with a non-finite number", "crack_branching", ("--set", "h=8e-4,inf")),
+    Row("nonlocal radius under 1.5 spacings", "crack_branching", ("--set", "nonlocal_radius=5e-4")),
     Row("unknown --method", "mandel", ("--method", "bem")),
     Row("unknown option", "mandel", ("--fast",)),
     Row("--out is a file", "mandel", ("--out", "notes.txt"), setup=_file("notes.txt")),

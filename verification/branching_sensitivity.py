@@ -47,6 +47,10 @@ VARIANTS = {  # name: the parameters that differ from the case's defaults
     "symmetric candidates": {"forward": False},
     "residual=1e-3": {"residual": 1e-3},
     "residual=1e-2": {"residual": 1e-2},
+    "nonlocal R=1mm": {"nonlocal_radius": 1e-3},
+    "nonlocal R=2mm": {"nonlocal_radius": 2e-3},
+    "nonlocal R=2mm eps_p=0": {"nonlocal_radius": 2e-3, "eps_p": 0.0},
+    "nonlocal R=2mm eps_p=0.25": {"nonlocal_radius": 2e-3, "eps_p": 0.25},
 }
 
 
@@ -55,10 +59,13 @@ def measure(h: float, overrides: dict) -> dict:
     ``residual``: the residual stiffness of the damage model); its measurements."""
     overrides = dict(overrides)
     residual = overrides.pop("residual", 0.0)
+    radius = overrides.pop("nonlocal_radius", None)
     prm = {k: p.default for k, p in cb.PARAMS.items()} | overrides
     material = dm.DamageMaterial(prm["E"], prm["nu"], prm["ft"], prm["GF"], prm["plane"])
     t0 = time.perf_counter()
     pl, track, model, f = cb.setup(h, material, prm)
+    if radius is not None:
+        model = dyn.damage_model(pl, material, nonlocal_radius=radius)
     model = replace(model, residual=residual)
     r = dyn.simulate("study", pl, model, track, [], prm["t_end"], external_force=lambda t: f)
     branches, split, counts = cb.branch_metrics(r.opening, pl.xs, pl.ys)
@@ -78,6 +85,9 @@ def measure(h: float, overrides: dict) -> dict:
     started = np.flatnonzero(r.kappa > model.kappa0)  # the particles that initiated
     chords = dm.chord_lengths(model.geometry, started, r.normal[started])
     ratio = dm.critical_strain(material, chords, model.volume[started]) / model.kappa0[started]
+    if model.nonlocal_average is not None:  # the band's kappa_c (rkfx.fracture.nonlocal_average)
+        kc = 2.0 * material.GF / (material.ft * model.nonlocal_average.band_width)
+        ratio = kc / model.kappa0[started]
     return {"h": h, "particles": pl.p.num_nodes, "branches": branches, "side_by_side": cb._most_cracks(counts, columns),
             "x_two_mm": 1e3 * float(two.max()) if two.size else None,
             "split_mm": 1e3 * split if np.isfinite(split) else None,

@@ -121,12 +121,15 @@ class ParameterError(InputError):
 
 
 def coerce(name: str, text: str, default: Any) -> Any:
-    """``text`` read as the type of ``default`` (lists: comma-separated, typed by their first item)."""
+    """``text`` read as the type of ``default`` (lists: comma-separated, typed by their first item;
+    ``none``: the empty list, e.g. to skip a study)."""
     if isinstance(default, (list, tuple)):
         kind = default[0] if default else ""
+        if text.strip().lower() == "none":
+            return []
         items = [t.strip() for t in text.split(",") if t.strip()]
         if not items:
-            raise ParameterError(f"{name}: expected a comma-separated list, got {text!r}")
+            raise ParameterError(f"{name}: expected a comma-separated list (or none), got {text!r}")
         return [coerce(name, t, kind) for t in items]
     if isinstance(default, bool):
         low = text.strip().lower()

@@ -18,12 +18,14 @@ lie in between (on the crack-branching model at h = 0.2 mm, 748 particles have w
 and 686 of them >= 0.9, while 1,854 have D >= 0.9).
 """
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
+from rkfx.errors import InputError
 from rkfx.fracture import damage as dm
+from rkfx.fracture.nonlocal_average import band_factor, nonlocal_average
 from rkfx.fracture.tracking import Tracking
 from rkfx.approximation.diffraction import Cracks, cracks
 from rkfx.assembly.lattice_stencil import template_particle
@@ -99,6 +101,22 @@ def memory_need(methods: Sequence[str], rkpm: dict[str, Sequence], fem: dict[str
                            f"{name}={','.join(f'{v:.6g}' for v in lists[name])}", f"{verb} {name}")
 
 
+def check_nonlocal(radius: float, spacings: Sequence[float], E: float, ft: float, GF: float) -> None:
+    """Raise InputError unless the nonlocal radius [m] spans 1.5-25 of the ``spacings`` [m] (a
+    particle's average must reach its neighbours, and its row holds pi (R / h)^2 entries) and
+    its band b is narrow enough that kappa_c = 2 G_F / (f_t b) exceeds kappa0."""
+    if not (np.isfinite(radius) and radius > 0):
+        raise InputError(f"nonlocal_radius = {radius!r} must be a positive length [m] (e.g. 2e-3)")
+    coarse, fine = max(spacings), min(spacings)
+    if radius < 1.5 * coarse:
+        raise InputError(f"nonlocal_radius = {radius:g} m is below 1.5 spacings of h = {coarse:g} m; "
+                         f"enlarge it or drop that spacing from nonlocal_h")
+    if radius > 25 * fine:
+        raise InputError(f"nonlocal_radius = {radius:g} m spans over 25 spacings of h = {fine:g} m (rows of "
+                         f"{np.pi * (radius / fine) ** 2:,.0f} entries per particle); use a radius below {25 * fine:g} m")
+    band_factor(E * GF / ft**2 / radius)  # raises if the band is too wide for G_F
+
+
 def plate(xs: np.ndarray, ys: np.ndarray, slits: Sequence, tips: Sequence[tuple[bool, bool]],
           material: dm.DamageMaterial, rho: float, support_factor: float = 1.5, courant: float = 0.5,
           eps_p: float = 1.0, comm=None) -> Plate:
@@ -128,10 +146,17 @@ def plate(xs: np.ndarray, ys: np.ndarray, slits: Sequence, tips: Sequence[tuple[
 
 
 def damage_model(pl: Plate, material: dm.DamageMaterial, regularized: bool = True,
-                 kappa_c: float | None = None) -> dm.DamageModel:
-    """The damage particles of the plate: regularized (4.28) on the cells, or a constant kappa_c."""
+                 kappa_c: float | None = None, nonlocal_radius: float = 0.0) -> dm.DamageModel:
+    """The damage particles of the plate: regularized (4.28) on the cells, or a constant kappa_c;
+    with ``nonlocal_radius`` > 0 [m] regularized by the nonlocal equivalent strain over that radius
+    instead (``rkfx.fracture.nonlocal_average``)."""
     geometry = dm.cell_geometry(pl.domains) if regularized else None
-    return dm.damage_model(material, pl.domains.area, geometry=geometry, kappa_c=kappa_c, regularized=regularized)
+    model = dm.damage_model(material, pl.domains.area, geometry=geometry, kappa_c=kappa_c, regularized=regularized)
+    if nonlocal_radius > 0 and regularized:
+        factor = band_factor(material.E * material.GF / material.ft**2 / nonlocal_radius)
+        average = nonlocal_average(pl.p.x, model.volume, nonlocal_radius, factor, pl.cracks.segments)
+        model = replace(model, nonlocal_average=average)
+    return model
 
 
 def simulate(label: str, pl: Plate, model: dm.DamageModel, track: Tracking | None, constraints: Sequence[Constraint],

@@ -31,6 +31,10 @@ Studies (``h`` lists nominal spacings [m]):
 * ``rkpm-dpm-unregularized``: a constant kappa_c = G_F / (f_t h_0), h_0 the spacing of the
   coarsest model, at ``unregularized_h`` (Fig 4.19a).
 
+* ``rkpm-dpm-nonlocal``: the damage history driven by the nonlocal equivalent strain over the
+  radius ``nonlocal_radius`` (``rkfx.fracture.nonlocal_average``: kappa_c of a band of physical
+  width, failed particles and the notch cut the averages), at ``nonlocal_h``;
+
 * ``fem-crack-band``: linear triangles with a crack band and the same damage law, lumped mass,
   central differences and consistent edge tractions (``fem_baselines.crack_band_dynamics``),
   at element sizes ``fem_h``; no tracking.
@@ -48,7 +52,7 @@ energy). A summary run per study maps h to branches and final dissipation
 and gives ``dissipation_change_fine``, |W_d(finest) - W_d(second finest)| / W_d(finest).
 
 Parameters (``--set NAME=VALUE``, SI units): E, nu, rho, ft, GF, sigma, plane, t_end, tol, h,
-unregularized_h, fem_h, support_factor, courant, radius, forward, eps_p. Long runs:
+unregularized_h, fem_h, support_factor, courant, radius, forward, eps_p, nonlocal_h, nonlocal_radius. Long runs:
 ``--checkpoint-every N`` writes each model's state every N steps to OUT/checkpoints/, and
 ``--resume DIR`` continues an interrupted invocation (finished models are read back). A resume
 with other parameters is refused in one line (``--recompute`` computes the runs again). Under
@@ -105,8 +109,10 @@ PARAMS = {
     "radius": Param(3.5, "tracking neighbourhood radius / nodal spacing [-], >= 1"),
     "forward": Param(True, "tracking: candidates only ahead of their particle (false: (4.22) both ways)"),
     "eps_p": Param(1.0, "weight of the MSCNI stabilization [-], >= 0 (0: plain SCNI)"),
+    "nonlocal_h": Param([8e-4, 4e-4, 2e-4], "nominal nodal spacings of the nonlocal models [m]"),
+    "nonlocal_radius": Param(2e-3, "radius R of the nonlocal equivalent strain [m], >= 1.5 spacings"),
 }
-QUICK = {"h": [1.6e-3, 8e-4], "unregularized_h": [1.6e-3, 8e-4], "fem_h": [1.6e-3, 8e-4]}
+QUICK = {"h": [1.6e-3, 8e-4], "unregularized_h": [1.6e-3, 8e-4], "fem_h": [1.6e-3, 8e-4], "nonlocal_h": [8e-4]}
 
 
 def _even(length: float, h: float) -> int:
@@ -122,10 +128,13 @@ def grid(h: float) -> tuple[np.ndarray, np.ndarray]:
     return np.linspace(0.0, LX, _even(LX, h)), np.linspace(0.0, LY, _even(LY, h))
 
 
-def _check(E, nu, rho, ft, GF, sigma, plane, t_end, tol, hs, support_factor, courant, radius, eps_p=1.0):
+def _check(E, nu, rho, ft, GF, sigma, plane, t_end, tol, hs, support_factor, courant, radius, eps_p=1.0,
+           nonlocal_hs=(), nonlocal_radius=2e-3):
     for name, v in (("rho", rho), ("sigma", sigma), ("t_end", t_end)):
         if not (np.isfinite(v) and v > 0):
             raise InputError(f"{name} = {v!r} must be positive")
+    if nonlocal_hs:
+        dyn.check_nonlocal(nonlocal_radius, nonlocal_hs, E, ft, GF)
     material = dm.DamageMaterial(E, nu, ft, GF, plane)
     check_tracking(tol, radius)
     if not support_factor >= 1.6:
@@ -147,15 +156,17 @@ def _check(E, nu, rho, ft, GF, sigma, plane, t_end, tol, hs, support_factor, cou
 
 
 def check(*, E, nu, rho, ft, GF, sigma, plane, t_end, tol, h, unregularized_h, fem_h, support_factor, courant,
-          radius, eps_p, **_) -> None:
+          radius, eps_p, nonlocal_h, nonlocal_radius, **_) -> None:
     """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
-    every = [float(v) for v in [*h, *unregularized_h, *fem_h]]
-    _check(E, nu, rho, ft, GF, sigma, plane, t_end, tol, every, support_factor, courant, radius, eps_p)
+    every = [float(v) for v in [*h, *unregularized_h, *fem_h, *nonlocal_h]]
+    _check(E, nu, rho, ft, GF, sigma, plane, t_end, tol, every, support_factor, courant, radius, eps_p,
+           [float(v) for v in nonlocal_h], nonlocal_radius)
 
 
-def memory_need(methods, *, h, unregularized_h, fem_h, **_) -> _preflight.Need:
+def memory_need(methods, *, h, unregularized_h, fem_h, nonlocal_h, **_) -> _preflight.Need:
     """Peak memory of the finest model, (LX / h) (LY / h) particles (see ``rkfx.cases._preflight``)."""
-    return dyn.memory_need(methods, {"h": h, "unregularized_h": unregularized_h}, {"fem_h": fem_h},
+    return dyn.memory_need(methods, {"h": h, "unregularized_h": unregularized_h, "nonlocal_h": nonlocal_h},
+                           {"fem_h": fem_h},
                            lambda v: (LX / v + 1) * (LY / v + 1) if v > 0 else 0.0, "raise")
 
 
@@ -167,19 +178,21 @@ def traction_force(pl: dyn.Plate, sigma: float) -> np.ndarray:
 
 
 def setup(h: float, material: dm.DamageMaterial, prm: dict, regularized: bool = True, kappa_c: float | None = None,
-          comm=None) -> tuple[dyn.Plate, object, dm.DamageModel, np.ndarray]:
+          comm=None, nonlocal_radius: float = 0.0) -> tuple[dyn.Plate, object, dm.DamageModel, np.ndarray]:
     """The plate of spacing ``h``, its tracking (seeded by the four particles around the tip),
-    damage model and edge force, for the parameters ``prm`` (``PARAMS`` names)."""
+    damage model (nonlocal over ``nonlocal_radius`` [m] if > 0) and edge force, for the
+    parameters ``prm`` (``PARAMS`` names)."""
     xs, ys = grid(h)
     pl = dyn.plate(xs, ys, [((0.0, A2), (A1, A2))], [(False, True)], material, prm["rho"], prm["support_factor"],
                    prm["courant"], prm["eps_p"], comm)
     seeds = np.linalg.norm(pl.p.x - np.array([A1, A2]), axis=1) < 0.75 * pl.h
     track = tracking(pl.p.x, pl.p.spacing, prm["tol"], seeds, prm["radius"], forward=prm["forward"])
-    return pl, track, dyn.damage_model(pl, material, regularized, kappa_c), traction_force(pl, prm["sigma"])
+    return (pl, track, dyn.damage_model(pl, material, regularized, kappa_c, nonlocal_radius),
+            traction_force(pl, prm["sigma"]))
 
 
-def _rkpm(label, study, h, material, prm, regularized=True, kappa_c=None, **io) -> Run:
-    pl, track, model, f = setup(h, material, prm, regularized, kappa_c, io.get("comm"))
+def _rkpm(label, study, h, material, prm, regularized=True, kappa_c=None, nonlocal_radius=0.0, **io) -> Run:
+    pl, track, model, f = setup(h, material, prm, regularized, kappa_c, io.get("comm"), nonlocal_radius)
     r = dyn.simulate(label, pl, model, track, [], prm["t_end"], external_force=lambda t: f, **io)
     return _run_record(r, study, h, pl, 2 * pl.p.num_nodes)
 
@@ -278,16 +291,18 @@ def _summary(study: str, runs: Sequence[Run]) -> Run:
 def run(*, methods: Sequence[str] = ("rkpm",), E=3.2e10, nu=0.2, rho=2450.0, ft=2.72e6, GF=3.0, sigma=1.0e6,
         plane="strain", t_end=80e-6, tol=0.5, h=(8e-4, 4e-4, 2e-4), unregularized_h=(8e-4, 4e-4, 2e-4),
         fem_h=(8e-4, 4e-4, 2e-4), support_factor=1.75, courant=0.5, radius=3.5, forward=True, eps_p=1.0,
-        checkpoint_every=0, work_dir=None, resume=None, vtk=None) -> Results:
+        nonlocal_h=(8e-4, 4e-4, 2e-4), nonlocal_radius=2e-3, checkpoint_every=0, work_dir=None, resume=None,
+        vtk=None) -> Results:
     """The damage particle method, regularized and with a constant kappa_c, at each spacing,
     and the crack-band finite elements at each element size; ``vtk``: a folder for every run's
     fields through time (``--vtk``)."""
     hs, unreg, fems = [float(v) for v in h], [float(v) for v in unregularized_h], [float(v) for v in fem_h]
-    material = _check(E, nu, rho, ft, GF, sigma, plane, t_end, tol, hs + unreg + fems, support_factor, courant,
-                      radius, eps_p)
+    nonloc = [float(v) for v in nonlocal_h]
+    material = _check(E, nu, rho, ft, GF, sigma, plane, t_end, tol, hs + unreg + fems + nonloc, support_factor,
+                      courant, radius, eps_p, nonloc, nonlocal_radius)
     prm = dict(E=E, nu=nu, rho=rho, ft=ft, GF=GF, sigma=sigma, plane=plane, t_end=t_end, tol=tol, h=hs,
                unregularized_h=unreg, fem_h=fems, support_factor=support_factor, courant=courant, radius=radius,
-               forward=forward, eps_p=eps_p)
+               forward=forward, eps_p=eps_p, nonlocal_h=nonloc, nonlocal_radius=nonlocal_radius)
     io = {"checkpoint_every": checkpoint_every, "work_dir": work_dir, "resume": resume, "comm": _cli.comm(), "vtk": vtk}
     xs, ys = grid(max(hs + unreg) if hs + unreg else 8e-4)
     h0 = float(max(np.diff(xs).max(), np.diff(ys).max()))
@@ -298,7 +313,8 @@ def run(*, methods: Sequence[str] = ("rkpm",), E=3.2e10, nu=0.2, rho=2450.0, ft=
         studies += [(study, levels, lambda v, study=study, kw=kw: _rkpm(f"{study} h={v:g}", study, v, material, prm,
                                                                         **kw, **io))
                     for study, levels, kw in (("rkpm-dpm", hs, {}), ("rkpm-dpm-unregularized", unreg,
-                                                                       {"regularized": False, "kappa_c": kappa_c}))]
+                                                                       {"regularized": False, "kappa_c": kappa_c}),
+                                              ("rkpm-dpm-nonlocal", nonloc, {"nonlocal_radius": nonlocal_radius}))]
     if "fem" in methods:
         studies.append(("fem-crack-band", fems, lambda v: _fem(v, prm, io)))
     dyn.run_studies(results, studies, _summary, level="h")
@@ -354,6 +370,8 @@ def plot(results: Results, out: Path) -> list[Path]:
             ("rkpm-dpm", "cracks", "damage particle method (regularized)", "damaged_w"),
             ("rkpm-dpm", "damage", "damage particle method (regularized)", "damaged_D"),
             ("rkpm-dpm-unregularized", "damage_unregularized", "constant $\\kappa_c$", "damaged_D"),
+            ("rkpm-dpm-nonlocal", "cracks_nonlocal",
+             f"nonlocal damage particle method (R = {1e3 * results.params['nonlocal_radius']:g} mm)", "damaged_w"),
             ("fem", "cracks_fem", "crack-band finite elements (no tracking)", "damaged_w")):
         runs = sorted((r for r in results.runs if r.info.get("study") == study), key=lambda r: -r.info["h"])
         if not runs:
@@ -370,7 +388,8 @@ def plot(results: Results, out: Path) -> list[Path]:
         files.append(_cli.save(fig, out / f"{fname}.png"))
     path = dyn.plot_dissipation(
         results, (("rkpm-dpm-unregularized", "(a) unregularized: constant $\\kappa_c$"),
-                  ("rkpm-dpm", "(b) damage particle method, regularized (4.28)"), ("fem", "(c) crack-band FEM")),
+                  ("rkpm-dpm", "(b) damage particle method, regularized (4.28)"),
+                  ("rkpm-dpm-nonlocal", "(c) nonlocal equivalent strain"), ("fem", "(d) crack-band FEM")),
         out / "dissipation.png", "crack branching: global fracture energy dissipation",
         label=lambda r: f"h = {1e3 * r.info['h']:.3f} mm", order=lambda r: -r.info["h"])
     if path:
@@ -398,6 +417,8 @@ CLAIMS = [
     Claim("Fig 4.19(a): without regularization the dissipation falls on refinement (h = 0.4 mm < 0.8x h = 0.8 mm)",
           info={"study": "rkpm-dpm-unregularized", "h_nominal": 4e-4}, key="dissipated_end", op="<", bound=0.8,
           over=(None, {"study": "rkpm-dpm-unregularized", "h_nominal": 8e-4}), full_only=True),
+    Claim("Nonlocal equivalent strain (R = 2 mm): two major branches at every spacing, the finest included",
+          info={"study": "rkpm-dpm-nonlocal"}, key="branches", op="==", bound=2),
     Claim("Sec 4.3: explicit central differences keep the energy balance of the damage particle method within 0.1 %",
           info=_DPM, key="energy_error", op="<", bound=1e-3),
     Claim("Sec 4.3.3: the crack-band FEM baseline beside it keeps its energy balance within 0.1 %",

@@ -49,6 +49,7 @@ from rkfx.approximation.sparse_rows import ranges
 from rkfx.materials import damage_law as law
 from rkfx.materials.elasticity import ElasticMaterial, out_of_plane_ratio, principal_direction
 from rkfx.errors import InputError
+from rkfx.fracture.nonlocal_average import NonlocalAverage
 from rkfx.geometry.nodal_domains import NodalDomains
 from rkfx.geometry.particles import Particles
 
@@ -379,6 +380,9 @@ class DamageModel:
             the stress is max(1 - D, eta) C e, so a cracked particle keeps the fraction eta of
             its stiffness (0, the default: none, as in (4.30)). A study option: the history,
             damage and dissipation are the law's; the energy balance counts the stress it carries.
+        nonlocal_average: The history driven by the nonlocal equivalent strain over a physical
+            radius, with kappa_c = 2 G_F / (f_t b) of its band width b
+            (``rkfx.fracture.nonlocal_average``; explicit dynamics only), or ``None``: local (4.6).
     """
 
     material: DamageMaterial
@@ -388,6 +392,7 @@ class DamageModel:
     kappa_c: np.ndarray | None
     band_factor: float = 1.0
     residual: float = 0.0
+    nonlocal_average: NonlocalAverage | None = None
 
     def __post_init__(self):
         if not 0.0 <= self.residual < 1.0:
@@ -517,7 +522,11 @@ def initiate(model: DamageModel, points: np.ndarray, effective: np.ndarray, norm
         # on a cut face, a notch reaching a boundary) has no chord; it takes the cell's size
         # sqrt(V_L), for kappa_c (4.28) and for the band width V_L / A_L of chapter 5 alike.
         chord[at] = np.where(c > 0, c, np.sqrt(model.volume[points]))
-        kappa_c[at] = model.band_factor * critical_strain(model.material, chord[at], model.volume[points])
+        if model.nonlocal_average is not None:  # a band of the average's physical width
+            mat = model.material
+            kappa_c[at] = 2.0 * mat.GF / (mat.ft * model.nonlocal_average.band_width)
+        else:
+            kappa_c[at] = model.band_factor * critical_strain(model.material, chord[at], model.volume[points])
 
 
 def update(model: DamageModel, state: DamageState, strain: np.ndarray, tangent: bool = True,
@@ -552,6 +561,9 @@ def update(model: DamageModel, state: DamageState, strain: np.ndarray, tangent: 
     A regularized kappa_c <= kappa0 (a cell too coarse for G_F) makes the point perfectly
     brittle; ``check_regularization`` rejects such converged states.
     """
+    if model.nonlocal_average is not None:
+        raise InputError("the nonlocal damage model runs in explicit dynamics only (rkfx.models.damage_dynamics); "
+                         "build the quasi-static model without nonlocal_average")
     mat = model.material
     elastic = mat.elastic
     c = elastic.D()

@@ -4,8 +4,9 @@ One internal-force evaluation of the damage particle method (eqs. 4.29-4.35) for
 central-difference stepper of ``rkfx.solvers.central_difference``:
 
 1. smeared strains of every particle, e~_L = B~(x_L) d (4.31), one sparse product;
-2. Mazars' equivalent strain (4.6) and, for particles allowed to damage, the history
-   kappa_L = max(kappa_L, eps_eq) (4.3)-(4.5);
+2. Mazars' equivalent strain (4.6) (with ``DamageModel.nonlocal_average``, its nonlocal
+   average over a physical radius, ``rkfx.fracture.nonlocal_average``) and, for particles
+   allowed to damage, the history kappa_L = max(kappa_L, eps_eq) (4.3)-(4.5);
 3. particles crossing their threshold for the first time fix their crack normal n_L along
    the major principal direction of the effective stress C e~ and, regularized, their
    kappa_c = (G_F / f_t) A_L / V_L (4.28) from the chord A_L of the cell; their tracking
@@ -97,6 +98,14 @@ class DamageField:
             seeds), ``(n,)`` int64 (``rkfx.fracture.tracking``: growth direction).
         clock: Time of the last force evaluation [s], shape ``(1,)`` (starts at -dt, so the
             evaluation of the initial state reads t = 0; checkpointed with the rest).
+        released: With the nonlocal equivalent strain, the energy each particle has dissipated,
+            sum over the steps of psi_L dD_L, psi_L = V_L e_L : C e_L / 2 (plus the MSCNI terms'
+            energy, which (1 - D_L) scales too) at the step's strain, ``(n,)`` [J per unit
+            thickness]; ``None`` for the local law, whose dissipation is the closed form
+            V_L phi(kappa_L) (``rkfx.fracture.damage``). The closed form assumes the strain
+            equals kappa while damage grows, which a nonlocal history breaks: in one dimension
+            it under-reports by 25-44 % at failure (``verification.nonlocal_band``).
+        psi: With ``released``, psi_L of the last step (the trapezoid in time), ``(n,)``.
     """
 
     kappa: np.ndarray
@@ -109,22 +118,31 @@ class DamageField:
     initiation_time: np.ndarray
     parent: np.ndarray
     clock: np.ndarray
+    released: np.ndarray | None = None
+    psi: np.ndarray | None = None
 
     @property
     def arrays(self) -> dict[str, np.ndarray]:
         """The arrays by name (the ``state()`` of ``DamageDynamics``: checkpointed, restored in place)."""
-        return {k: getattr(self, k) for k in ("kappa", "damage", "normal", "kappa_c", "chord", "damaged",
-                                              "allowed", "initiation_time", "parent", "clock")}
+        names = ("kappa", "damage", "normal", "kappa_c", "chord", "damaged", "allowed", "initiation_time", "parent",
+                 "clock") + (() if self.released is None else ("released", "psi"))
+        return {k: getattr(self, k) for k in names}
 
     def dissipated(self, model: DamageModel) -> float:
-        """Energy dissipated so far, sum_L V_L phi(kappa_L) [J per unit thickness] (``rkfx.fracture.damage``)."""
+        """Energy dissipated so far, sum_L V_L phi(kappa_L) [J per unit thickness] (``rkfx.fracture.damage``;
+        with the nonlocal law the sum of ``released``)."""
+        if self.released is not None:
+            return float(self.released.sum())
         i = np.flatnonzero(self.damaged)
         if i.size == 0:
             return 0.0
         return float(np.sum(self._dissipation(model, i)))
 
     def dissipation(self, model: DamageModel) -> np.ndarray:
-        """Energy dissipated so far per point, V_L phi(kappa_L) [J per unit thickness], ``(n,)``."""
+        """Energy dissipated so far per point, V_L phi(kappa_L) [J per unit thickness], ``(n,)``
+        (with the nonlocal law ``released``)."""
+        if self.released is not None:
+            return self.released.copy()
         out = np.zeros(len(self.kappa))
         i = np.flatnonzero(self.damaged)
         out[i] = self._dissipation(model, i)
@@ -141,7 +159,8 @@ def damage_field(model: DamageModel, track: Tracking | None = None, dt: float = 
     kc = np.full(n, np.nan) if model.regularized else model.kappa_c.copy()
     allowed = np.ones(n, bool) if track is None or not track.enabled else track.seeds.copy()
     return DamageField(np.zeros(n), np.zeros(n), np.zeros((n, 2)), kc, np.full(n, np.nan), np.zeros(n, bool),
-                       allowed, np.full(n, np.nan), np.full(n, -1, np.int64), np.array([-float(dt)]))
+                       allowed, np.full(n, np.nan), np.full(n, -1, np.int64), np.array([-float(dt)]),
+                       *((None, None) if model.nonlocal_average is None else (np.zeros(n), np.zeros(n))))
 
 
 class DamageForce:
@@ -175,10 +194,17 @@ class DamageForce:
         e, diff = op.strains(d) if stab is not None else (op.strain(d), None)
         strain_kernel(e, self.c, self.nu_zz, f.allowed, f.damaged, self.kappa0, self._eq, self._effective,
                       self._crossing)
+        if self.model.nonlocal_average is not None:
+            self._average()
         f.clock[0] += self.dt
         self._initiate_all(np.flatnonzero(self._crossing))
+        before = f.damage[self._rows] if f.released is not None else None
         damage_kernel(self._eq, self._effective, f.allowed, f.damaged, self.kappa0, f.kappa_c, f.kappa, f.damage,
                       self.stress)
+        if before is not None:  # psi dD at the step's strain (DamageField.released)
+            ptr, weight = _subcell_terms(op)
+            _release(self._rows, before, f.damage, e, self._effective, np.empty((0, 3)) if diff is None else diff,
+                     ptr, weight, self.c, self.model.volume, f.psi, f.released)
         damage = f.damage
         if self.residual > 0:  # max(1 - D, eta) C e
             kept = np.maximum(1.0 - f.damage, self.residual)
@@ -187,6 +213,22 @@ class DamageForce:
         if stab is None:
             return op.force(self.stress)
         return op.damaged_force(self.stress, diff, self.c, damage)
+
+    def _average(self) -> None:
+        """The allowed particles' equivalent strains replaced by their nonlocal averages
+        (``rkfx.fracture.nonlocal_average``), and their threshold crossings taken on those."""
+        f = self.field
+        self._rows = rows = np.flatnonzero(f.allowed)
+        values, failed = self._nonlocal_inputs()
+        self.model.nonlocal_average.average(values, rows, self._eq, failed)
+        self._crossing[rows] = ~f.damaged[rows] & (self._eq[rows] >= self.kappa0[rows])
+        # A particle admitted by this step's initiations starts its history from the next
+        # step's average, not from its local strain.
+        self._eq[~f.allowed] = 0.0
+
+    def _nonlocal_inputs(self) -> tuple[np.ndarray, np.ndarray]:
+        """The local equivalent strains and failed flags of every particle (the ranks gather them)."""
+        return self._eq.copy(), self.field.damage >= 1.0
 
     def _initiate_all(self, new: np.ndarray) -> None:
         """The initiations of this evaluation (``rkfx.models.damage_ranks`` gathers them over ranks)."""
@@ -202,6 +244,34 @@ class DamageForce:
         f.initiation_time[new] = f.clock[0]
         if self.track is not None and self.track.enabled:
             admit(*self.track.candidates(new, f.normal[new], f.parent[new]), f.allowed, f.parent)
+
+
+def _subcell_terms(op) -> tuple[np.ndarray, np.ndarray]:
+    """(ptr, eps_p A_C) of the MSCNI subcells of each damage point of ``op`` (a whole operator's
+    ``stabilization`` or a rank's share), or no subcells."""
+    s = getattr(op, "stabilization", None)
+    if s is None:
+        return np.zeros(op.num_nodes + 1, np.int64), np.empty(0)
+    return (s.ptr, s.weight) if hasattr(s, "ptr") else (op.ptr, op.weight)
+
+
+@numba.njit(parallel=True, cache=True)
+def _release(rows, before, damage, strain, effective, differences, ptr, weight, c, volume, psi_last, released):
+    """released_L += (psi_L + psi_L,last) / 2 (D_L - D_L,before) over ``rows`` (the trapezoid in
+    time, as the internal work), psi_L the undamaged energy of particle L, V_L e : C e / 2 plus its
+    MSCNI terms' eps_p A_C dE : C dE / 2 (the energy that (1 - D_L) scales in the force), at the
+    step's strain; ``psi_last`` holds psi_L of the last step and takes this one's."""
+    for k in numba.prange(rows.shape[0]):
+        i = rows[k]
+        dd = damage[i] - before[k]
+        psi = 0.5 * volume[i] * (strain[i, 0] * effective[i, 0] + strain[i, 1] * effective[i, 1]
+                                 + strain[i, 2] * effective[i, 2])
+        for q in range(ptr[i], ptr[i + 1]):
+            for a in range(3):
+                sa = c[a, 0] * differences[q, 0] + c[a, 1] * differences[q, 1] + c[a, 2] * differences[q, 2]
+                psi += 0.5 * weight[q] * differences[q, a] * sa
+        released[i] += 0.5 * (psi + psi_last[i]) * dd
+        psi_last[i] = psi
 
 
 class DamageDynamics(ExplicitDynamics):

@@ -14,6 +14,9 @@ on the rank's local vectors as it would serially; per step the ranks exchange:
   boundaries; each rank keeps only the neighbour sets that reach its particles
   (``Tracking.near``); how many initiated on each rank is one all-gather of a count per step
   (with tracking on);
+* with the nonlocal equivalent strain (``rkfx.fracture.nonlocal_average``), every rank's
+  strains and failed flags (two all-gathers of one number per particle), which the averages
+  of the rank's allowed particles read;
 * the energies and the history samples (all-reduces of a few numbers).
 
 The constraint rows are replicated (the columns of G are ghosts everywhere), so every rank
@@ -61,8 +64,10 @@ def _summed(comm, values: np.ndarray) -> np.ndarray:
 def restricted(model: DamageModel, points: np.ndarray) -> DamageModel:
     """The data of ``points`` of ``model`` (the cell geometry stays whole: it is read by the
     global indices of initiating points)."""
+    average = model.nonlocal_average
     return replace(model, volume=model.volume[points], kappa0=model.kappa0[points],
-                   kappa_c=None if model.kappa_c is None else model.kappa_c[points])
+                   kappa_c=None if model.kappa_c is None else model.kappa_c[points],
+                   nonlocal_average=None if average is None else average.restricted(points))
 
 
 class RankDamageForce(DamageForce):
@@ -79,6 +84,9 @@ class RankDamageForce(DamageForce):
         self.tracked = tracked
         if tracked:
             field.allowed[:] = track.seeds[op.points]
+        if model.nonlocal_average is not None:  # the ranks' points, in rank order, for the gathers
+            self._point_counts = np.array(comm.allgather(len(op.points)), np.int64)
+            self._every_point = np.concatenate(comm.allgather(np.asarray(op.points, np.int64)))
         self._counts = np.zeros(comm.size, np.int64)
         self._one = np.zeros(1, np.int64)
 
@@ -97,6 +105,17 @@ class RankDamageForce(DamageForce):
         every = np.empty((total, 4))
         self.comm.Allgatherv(mine, [every, 4 * self._counts])
         return every[:, 0].astype(np.int64), np.ascontiguousarray(every[:, 1:3]), every[:, 3].astype(np.int64)
+
+    def _nonlocal_inputs(self) -> tuple[np.ndarray, np.ndarray]:
+        """The equivalent strains and failed flags of every particle, gathered (collective: one
+        all-gather of the ranks' strains and one of their flags per step)."""
+        counts = self._point_counts
+        eq, failed = np.empty(int(counts.sum())), np.empty(int(counts.sum()), np.bool_)
+        self.comm.Allgatherv(self._eq, [eq, counts])
+        self.comm.Allgatherv(self.field.damage >= 1.0, [failed, counts])
+        values, flags = np.empty_like(eq), np.empty_like(failed)
+        values[self._every_point], flags[self._every_point] = eq, failed
+        return values, flags
 
     def _initiate_all(self, new: np.ndarray) -> None:
         f, points = self.field, self.op.points

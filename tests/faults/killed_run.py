@@ -23,8 +23,8 @@ import numpy as np
 
 from rkfx.solvers import checkpoint
 
-ARGS = ["--method", "rkpm", "--set", "h=2.564e-3", "unregularized_h=2.564e-3", "no_tracking_h=2.564e-3", "t_end=2e-5",
-        "--checkpoint-every", "20"]
+ARGS = ["--method", "rkpm", "--set", "h=2.564e-3", "unregularized_h=2.564e-3", "no_tracking_h=2.564e-3", "nonlocal_h=none",
+        "t_end=2e-5", "--checkpoint-every", "20"]
 MANDEL_ARGS = ["--quick", "--method", "rkpm", "--checkpoint-every", "4"]
 CASE_ARGS = {"kalthoff": ARGS, "mandel": MANDEL_ARGS}
 
