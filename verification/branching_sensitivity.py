@@ -34,6 +34,7 @@ from scipy.spatial import cKDTree
 
 from rkfx.cases import _dynamic_fracture as dyn
 from rkfx.cases import crack_branching as cb
+from rkfx.errors import InputError
 from rkfx.fracture import damage as dm
 
 ONSET_BANDS = ((0.0, 1e-3), (1e-3, 3e-3), (3e-3, np.inf))  # distance to the nearest cracked particle [m]
@@ -145,7 +146,11 @@ def main(argv=None) -> int:
         "kappa_c/kappa0", "wall [s]"])
     for h in hs:
         for name in names:
-            m = measure(h, VARIANTS[name]) | {"variant": name}
+            try:
+                m = measure(h, VARIANTS[name]) | {"variant": name}
+            except InputError as err:  # e.g. a nonlocal radius under 1.5 spacings of this h
+                print(f"| {1e3 * h:.1f} | {name} | refused: {err} |", flush=True)
+                continue
             rows.append(m)
             (args.out / "sensitivity.json").write_text(json.dumps(rows, indent=1) + "\n")
             print(ROW.format(**{**m, "h": 1e3 * h, "split": "-" if m["split_mm"] is None else f"{m['split_mm']:.1f}",
