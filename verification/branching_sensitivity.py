@@ -64,9 +64,7 @@ def measure(h: float, overrides: dict) -> dict:
     prm = {k: p.default for k, p in cb.PARAMS.items()} | overrides
     material = dm.DamageMaterial(prm["E"], prm["nu"], prm["ft"], prm["GF"], prm["plane"])
     t0 = time.perf_counter()
-    pl, track, model, f = cb.setup(h, material, prm)
-    if radius is not None:
-        model = dyn.damage_model(pl, material, nonlocal_radius=radius)
+    pl, track, model, f = cb.setup(h, material, prm, nonlocal_radius=radius or 0.0)
     model = replace(model, residual=residual)
     r = dyn.simulate("study", pl, model, track, [], prm["t_end"], external_force=lambda t: f)
     branches, split, counts = cb.branch_metrics(r.opening, pl.xs, pl.ys)

@@ -141,7 +141,8 @@ def grid(n: int) -> tuple[np.ndarray, np.ndarray]:
     return np.linspace(0.0, SIDE, nx), np.linspace(0.0, SIDE, ny)
 
 
-def _check(E, nu, rho, ft, GF, v0, t_end, tol, nodes, support_factor, courant, radius, angle_radius, eps_p=1.0):
+def _check(E, nu, rho, ft, GF, v0, t_end, tol, nodes, support_factor, courant, radius, angle_radius, eps_p=1.0,
+           nonlocal_h=(), nonlocal_radius=2e-3):
     for name, v in (("rho", rho), ("v0", v0), ("t_end", t_end), ("angle_radius", angle_radius)):
         if not (np.isfinite(v) and v > 0):
             raise InputError(f"{name} = {v!r} must be positive")
@@ -161,6 +162,8 @@ def _check(E, nu, rho, ft, GF, v0, t_end, tol, nodes, support_factor, courant, r
     if not material.critical_opening / 2 / h > material.kappa0:
         raise InputError(f"h = {h:.4g} m is too coarse for G_F: kappa_c = G_F / (f_t h) <= kappa0; use "
                          f"h < E G_F / f_t^2 = {E * GF / ft**2:.3g} m")
+    if nonlocal_h:
+        dyn.check_nonlocal(nonlocal_radius, [float(v) for v in nonlocal_h], E, ft, GF)
     return material
 
 
@@ -168,9 +171,8 @@ def check(*, E, nu, rho, ft, GF, v0, t_end, tol, h, unregularized_h, no_tracking
           support_factor, courant, radius, angle_radius, eps_p, nonlocal_h, nonlocal_radius, **_) -> None:
     """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
     every = columns([*h, *unregularized_h, *no_tracking_h, *fem_h, *nonlocal_h])
-    _check(E, nu, rho, ft, GF, v0, t_end, tol, every, support_factor, courant, radius, angle_radius, eps_p)
-    if nonlocal_h:
-        dyn.check_nonlocal(nonlocal_radius, [float(v) for v in nonlocal_h], E, ft, GF)
+    _check(E, nu, rho, ft, GF, v0, t_end, tol, every, support_factor, courant, radius, angle_radius, eps_p,
+           nonlocal_h, nonlocal_radius)
 
 
 def memory_need(methods, *, h, unregularized_h, no_tracking_h, fem_h, nonlocal_h, **_) -> _preflight.Need:
@@ -269,9 +271,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.9e11, nu=0.3, rho=8000.
     through time (``--vtk``)."""
     nodes, unreg, free, fem, nonloc = (columns(v) for v in (h, unregularized_h, no_tracking_h, fem_h, nonlocal_h))
     material = _check(E, nu, rho, ft, GF, v0, t_end, tol, nodes + unreg + free + fem + nonloc, support_factor,
-                      courant, radius, angle_radius, eps_p)
-    if nonloc:
-        dyn.check_nonlocal(nonlocal_radius, [float(v) for v in nonlocal_h], E, ft, GF)
+                      courant, radius, angle_radius, eps_p, nonlocal_h, nonlocal_radius)
     prm = {"E": E, "nu": nu, "rho": rho, "ft": ft, "GF": GF, "v0": v0, "t_end": t_end, "tol": tol, "h": list(h),
            "unregularized_h": list(unregularized_h), "no_tracking_h": list(no_tracking_h), "fem_h": list(fem_h),
            "support_factor": support_factor, "courant": courant, "radius": radius, "forward": forward, "eps_p": eps_p,

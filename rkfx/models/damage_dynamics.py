@@ -187,6 +187,7 @@ class DamageForce:
         self._crossing = np.empty(n, np.bool_)
         self.stress = np.empty((n, 3))
         self.residual = float(model.residual)
+        self._subcells = _subcell_terms(op) if model.nonlocal_average is not None else None
 
     def __call__(self, d: np.ndarray) -> np.ndarray:
         f, op = self.field, self.op
@@ -202,9 +203,9 @@ class DamageForce:
         damage_kernel(self._eq, self._effective, f.allowed, f.damaged, self.kappa0, f.kappa_c, f.kappa, f.damage,
                       self.stress)
         if before is not None:  # psi dD at the step's strain (DamageField.released)
-            ptr, weight = _subcell_terms(op)
-            _release(self._rows, before, f.damage, e, self._effective, np.empty((0, 3)) if diff is None else diff,
-                     ptr, weight, self.c, self.model.volume, f.psi, f.released)
+            ptr, weight, none = self._subcells
+            _release(self._rows, before, f.damage, e, self._effective, none if diff is None else diff, ptr, weight,
+                     self.c, self.model.volume, f.psi, f.released)
         damage = f.damage
         if self.residual > 0:  # max(1 - D, eta) C e
             kept = np.maximum(1.0 - f.damage, self.residual)
@@ -246,13 +247,13 @@ class DamageForce:
             admit(*self.track.candidates(new, f.normal[new], f.parent[new]), f.allowed, f.parent)
 
 
-def _subcell_terms(op) -> tuple[np.ndarray, np.ndarray]:
+def _subcell_terms(op) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(ptr, eps_p A_C) of the MSCNI subcells of each damage point of ``op`` (a whole operator's
-    ``stabilization`` or a rank's share), or no subcells."""
-    s = getattr(op, "stabilization", None)
+    ``stabilization`` or a rank's share), or no subcells; and the empty differences of no subcells."""
+    s, none = getattr(op, "stabilization", None), np.empty((0, 3))
     if s is None:
-        return np.zeros(op.num_nodes + 1, np.int64), np.empty(0)
-    return (s.ptr, s.weight) if hasattr(s, "ptr") else (op.ptr, op.weight)
+        return np.zeros(op.num_nodes + 1, np.int64), np.empty(0), none
+    return (s.ptr, s.weight, none) if hasattr(s, "ptr") else (op.ptr, op.weight, none)
 
 
 @numba.njit(parallel=True, cache=True)
