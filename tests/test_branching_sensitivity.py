@@ -26,3 +26,11 @@ def test_the_residual_stiffness_variant_reaches_the_damage_model():
     that share of its stiffness), which changes the run."""
     plain, stiff = study.measure(1.6e-3, {}), study.measure(1.6e-3, study.VARIANTS["residual=1e-2"])
     assert stiff["dissipated"] > 0 and stiff["dissipated"] != plain["dissipated"]
+
+
+def test_the_untracked_variants_switch_the_tracking_off():
+    """tracked=False lets every particle damage: the spurious damage of Fig 4.16 spreads, so the
+    run differs from the tracked one."""
+    assert study.VARIANTS["nonlocal R=2mm untracked"]["tracked"] is False
+    plain, free = study.measure(1.6e-3, {}), study.measure(1.6e-3, {"tracked": False})
+    assert free["dissipated"] > 0 and free["dissipated"] != plain["dissipated"]

@@ -52,20 +52,25 @@ VARIANTS = {  # name: the parameters that differ from the case's defaults
     "nonlocal R=2mm": {"nonlocal_radius": 2e-3},
     "nonlocal R=2mm eps_p=0": {"nonlocal_radius": 2e-3, "eps_p": 0.0},
     "nonlocal R=2mm eps_p=0.25": {"nonlocal_radius": 2e-3, "eps_p": 0.25},
+    "nonlocal R=2mm untracked": {"nonlocal_radius": 2e-3, "tracked": False},
+    "nonlocal R=2mm eps_p=0 untracked": {"nonlocal_radius": 2e-3, "eps_p": 0.0, "tracked": False},
 }
 
 
 def measure(h: float, overrides: dict) -> dict:
-    """One regularized run of the case at spacing ``h`` [m] with ``overrides`` (case parameters, and
-    ``residual``: the residual stiffness of the damage model); its measurements."""
+    """One regularized run of the case at spacing ``h`` [m] with ``overrides`` (case parameters,
+    ``residual``: the residual stiffness of the damage model, ``nonlocal_radius`` [m], and
+    ``tracked``: ``False`` lets every particle damage); its measurements."""
     overrides = dict(overrides)
     residual = overrides.pop("residual", 0.0)
     radius = overrides.pop("nonlocal_radius", None)
+    tracked = overrides.pop("tracked", True)
     prm = {k: p.default for k, p in cb.PARAMS.items()} | overrides
     material = dm.DamageMaterial(prm["E"], prm["nu"], prm["ft"], prm["GF"], prm["plane"])
     t0 = time.perf_counter()
     pl, track, model, f = cb.setup(h, material, prm, nonlocal_radius=radius or 0.0)
     model = replace(model, residual=residual)
+    track = track if tracked else replace(track, enabled=False)
     r = dyn.simulate("study", pl, model, track, [], prm["t_end"], external_force=lambda t: f)
     branches, split, counts = cb.branch_metrics(r.opening, pl.xs, pl.ys)
     columns = pl.xs[pl.xs > cb.A1]
