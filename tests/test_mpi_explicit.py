@@ -44,7 +44,7 @@ def assert_same_runs(a: dict, b: dict) -> None:
         rb = b[name]
         for key in ("damaged_index", "damaged_D", "damaged_w", "damage", "opening"):
             assert ra["series"].get(key) == rb["series"].get(key), (name, key)
-        for key in ("dissipated", "damaged", "kinetic", "internal", "external"):
+        for key in ("dissipated", "damaged", "kinetic", "internal", "external", "released"):
             if key in ra["series"]:
                 x, y = np.asarray(ra["series"][key], float), np.asarray(rb["series"][key], float)
                 assert np.abs(x - y).max() <= 1e-10 * max(np.abs(x).max(), 1e-300), (name, key)

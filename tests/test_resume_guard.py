@@ -134,3 +134,16 @@ def test_bad_input_leaves_no_fingerprint(tmp_path, capsys):
     with pytest.raises(SystemExit):
         kalthoff.main([*ARGS, "--recompute", "--out", str(out)])
     assert "--recompute" in capsys.readouterr().err and not out.exists()
+
+
+def test_a_checkpoint_of_another_shape_is_refused_in_one_line():
+    """A history written by another version (e.g. fewer history columns) names the array and
+    the way out instead of failing inside numpy."""
+    from rkfx.solvers.checkpoint import copy_into
+
+    target = {"history": np.zeros((4, 7))}
+    with pytest.raises(InputError, match=r"'history' has shape \(4, 6\), this run's \(4, 7\).*delete it") as err:
+        copy_into(target, {"history": np.ones((4, 6))}, "run history")
+    assert "\n" not in str(err.value)
+    copy_into(target, {"history": np.ones((4, 7))}, "run history")
+    assert target["history"].sum() == 28

@@ -254,7 +254,7 @@ def run_series(r: DamageRun) -> dict:
     hist = r.history
     damaged = np.flatnonzero(r.damage > 0.01)
     return {"time_us": 1e6 * hist[:, 0], "dissipated": hist[:, 1], "damaged": hist[:, 2], "kinetic": hist[:, 3],
-            "internal": hist[:, 4], "external": hist[:, 5], "damaged_index": damaged,
+            "internal": hist[:, 4], "external": hist[:, 5], "released": r.released, "damaged_index": damaged,
             "damaged_D": np.round(r.damage[damaged], 4), "damaged_w": np.round(r.opening[damaged], 4)}
 
 
@@ -280,7 +280,8 @@ def label_map_axes(ax) -> None:
 
 def plot_dissipation(results, panels: Sequence[tuple[str, str]], path: Path, title: str,
                      label: Callable, order: Callable, scale: float = 1.0, unit: str = "J/m") -> Path | None:
-    """Dissipation histories side by side, one panel per study present in ``results``.
+    """Dissipation histories side by side, one panel per study present in ``results``: the
+    law's dissipation (solid) and the energy released, internal work less stored (dashed).
 
     Args:
         panels: ``(study, panel title)`` pairs; studies without runs are skipped.
@@ -298,8 +299,12 @@ def plot_dissipation(results, panels: Sequence[tuple[str, str]], path: Path, tit
     for ax, (study, head) in zip(axes[0], panels):
         runs = sorted((r for r in results.runs if r.info.get("study") == study), key=order)
         for k, r in enumerate(runs):
-            ax.plot(r.series["time_us"], np.asarray(r.series["dissipated"]) / scale,
-                    color=plt.cm.viridis(k / max(1, len(runs) - 1) * 0.85), label=label(r))
+            color = plt.cm.viridis(k / max(1, len(runs) - 1) * 0.85)
+            ax.plot(r.series["time_us"], np.asarray(r.series["dissipated"]) / scale, color=color, label=label(r))
+            if "released" in r.series:  # the work the damage took, beside the law's sum
+                ax.plot(r.series["time_us"], np.asarray(r.series["released"]) / scale, color=color, lw=0.8, ls="--")
+        if any("released" in r.series for r in runs):
+            ax.plot([], [], color="0.4", lw=0.8, ls="--", label="dashed: released (work - stored)")
         ax.set_title(head, fontsize=10)
         ax.set_xlabel("time [µs]")
         ax.grid(alpha=0.3)

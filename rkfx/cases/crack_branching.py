@@ -47,8 +47,10 @@ cracks that run side by side over at least 5 mm of x anywhere beyond a1 (``_dyna
 arrested branches and a central crack count, short spurs do not), ``tip_x`` [m], the largest x
 of the cracked particles (crack opening w / w_c >= 0.5, ``_dynamic_fracture``),
 ``dissipated_end`` [J/m] with its history and the share spent in the cracked particles
-(``dissipated_in_cracks``), and ``energy_error`` (max |energy balance| / max
-energy). A summary run per study maps h to branches and final dissipation
+(``dissipated_in_cracks``), ``released_end`` [J/m] (the internal work less the strain energy
+still stored: what the damage took out of the discrete solid; with the local law more than
+``dissipated_end``, the law's sum V_L phi(kappa_L), docs/fracture.md), and ``energy_error``
+(max |energy balance| / max energy). A summary run per study maps h to branches and final dissipation
 and gives ``dissipation_change_fine``, |W_d(finest) - W_d(second finest)| / W_d(finest).
 
 Parameters (``--set NAME=VALUE``, SI units): E, nu, rho, ft, GF, sigma, plane, t_end, tol, h,
@@ -241,7 +243,8 @@ def _run_record(r: DamageRun, study, h, pl: dyn.Plate, dofs) -> Run:
 
 def _errors(r: DamageRun, branches: int, branch_x: float, most: int, tip_x: float) -> dict:
     return {"branches": branches, "branch_x": branch_x, "most_cracks": most, "tip_x": tip_x,
-            "dissipated_end": float(r.history[-1, 1]), "dissipated_in_cracks": dyn.crack_share(r),
+            "dissipated_end": float(r.history[-1, 1]), "released_end": float(r.released[-1]),
+            "dissipated_in_cracks": dyn.crack_share(r),
             "energy_error": r.energy_error}
 
 

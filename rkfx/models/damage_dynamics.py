@@ -42,7 +42,8 @@ checkpoints and restores. ``run_damage`` runs a model and keeps finished work: w
 directory each finished run is written to ``WORK/<label>/result.npz`` and, with
 ``checkpoint_every``, its state to ``WORK/<label>/checkpoint.npz`` as it runs; resuming reads
 a finished run back and continues an interrupted one from its checkpoint. The sampled
-history (time, dissipated energy, damaged points, energies) is the stepper's recorder, a
+history (time, dissipated energy, damaged points, energies, the strain energy still stored) is
+the stepper's recorder, a
 fixed array checkpointed with the damage history, so a resumed run reports the same history
 as an uninterrupted one.
 """
@@ -65,7 +66,7 @@ from rkfx.assembly.smeared_strain import SmearedStrain, StrainRecipe
 from rkfx.solvers.central_difference import CentralDifference, Constraint, ExplicitDynamics, ExplicitState
 from rkfx.solvers.checkpoint import copy_into, has_checkpoint, log, read_arrays, run_folder, save_arrays
 
-HISTORY = ("time", "dissipated", "damaged", "kinetic", "internal", "external")
+HISTORY = ("time", "dissipated", "damaged", "kinetic", "internal", "external", "stored")
 
 
 class StrainOperator(Protocol):
@@ -328,8 +329,10 @@ class _Samples:
                  total: Callable[[np.ndarray], np.ndarray] | None = None, frames: Frames | None = None,
                  progress: Callable[[int], None] | None = None):
         self.field, self.model = dynamics.field, dynamics.damage_model
+        share = getattr(dynamics, "share", None)
+        self.owned = None if share is None else np.asarray(share.owned, float)  # 1 on owned unknowns, 0 on ghosts
         self.progress = progress
-        self.total = total  # sums a rank's (dissipated, damaged) over the ranks
+        self.total = total  # sums a rank's (dissipated, damaged, stored) over the ranks
         self.frames = frames
         self.frame_every = 1 if frames is None else max(1, (steps // every + 1) // max(1, frames.count))
         self.frame_time = -np.inf  # the time of the last frame written
@@ -345,10 +348,13 @@ class _Samples:
             self.base = float(self.wall[0])
         self.wall[0] = self.base + time.perf_counter() - self.t0 - self.frame_seconds
         e = s.energy
-        damage = np.array([self.field.dissipated(self.model), self.field.damaged.sum()], float)
+        # The strain energy still stored, d . f_int(d) / 2: the force is linear in d at the
+        # step's damage (max(1 - D, eta) of the cell and MSCNI terms alike).
+        d = s.d if self.owned is None else s.d * self.owned
+        damage = np.array([self.field.dissipated(self.model), self.field.damaged.sum(), 0.5 * float(d @ s.f_int)])
         if self.total is not None:
             damage = self.total(damage)
-        self.history[self.slot[0]] = (s.time, damage[0], damage[1], e[0], e[1], e[2] + e[3])
+        self.history[self.slot[0]] = (s.time, damage[0], damage[1], e[0], e[1], e[2] + e[3], damage[2])
         if self.frames is not None and self.slot[0] % self.frame_every == 0:
             self.frame(s)
         self.slot[0] += 1
@@ -388,8 +394,10 @@ class DamageRun:
     Attributes:
         label: Run label.
         history: Sampled (time [s], dissipated [J/m], damaged points, kinetic energy,
-            internal work, external work [J/m]), shape ``(k, 6)`` (columns ``HISTORY``); the
-            external work includes that of the prescribed motions (e.g. an impact velocity).
+            internal work, external work, stored strain energy [J/m]), shape ``(k, 7)``
+            (columns ``HISTORY``); the external work includes that of the prescribed motions
+            (e.g. an impact velocity). ``released`` is what the internal work leaves after
+            the stored energy: the energy the damage has taken out of the discrete solid.
         damage, kappa, normal, initiation_time: Final damage history per particle.
         opening: Final crack opening over the critical opening, w / w_c per particle
             (``rkfx.fracture.damage.crack_opening``: the fraction of its fracture energy spent).
@@ -420,6 +428,14 @@ class DamageRun:
     def column(self, name: str) -> np.ndarray:
         return self.history[:, HISTORY.index(name)]
 
+    @property
+    def released(self) -> np.ndarray:
+        """Internal work - stored strain energy at every sample [J/m]: the energy the damage
+        released. With the local law it exceeds the law's ``dissipated`` = sum V_L phi(kappa_L),
+        which counts only what Mazars' norm sees (docs/fracture.md); with the nonlocal law the
+        two are the same sum, per step and in total."""
+        return self.column("internal") - self.column("stored")
+
     def save(self, path: Path) -> None:
         save_arrays(path.parent, dict(
             history=self.history, damage=self.damage, kappa=self.kappa, normal=self.normal,
@@ -430,8 +446,9 @@ class DamageRun:
     @classmethod
     def load(cls, path: Path) -> "DamageRun":
         z = read_arrays(path)
-        if "dissipation" not in z:
-            raise InputError(f"{path} predates the per-particle crack outputs; run again without --resume")
+        if "dissipation" not in z or z["history"].shape[1] != len(HISTORY):
+            raise InputError(f"{path} predates the per-particle crack outputs or the stored-energy history; "
+                             "run again without --resume")
         return cls(str(z["label"]), z["history"], z["damage"], z["kappa"], z["normal"], z["initiation_time"],
                    z["opening"], z["dissipation"], z["displacement"], z["velocity"], int(z["steps"]),
                    float(z["dt"]), float(z["wall_time_s"]), float(z["energy_error"]))

@@ -232,6 +232,9 @@ def copy_into(targets: Mapping[str, np.ndarray], arrays: Mapping[str, np.ndarray
     for k, arr in targets.items():
         if k not in arrays:
             raise InputError(f"checkpoint has no {what} {k!r}; it holds {sorted(arrays)}")
+        if np.shape(arrays[k]) != arr.shape:
+            raise InputError(f"checkpoint's {what} {k!r} has shape {np.shape(arrays[k])}, this run's {arr.shape}: "
+                             "it was written by another version or set-up; delete it to start afresh")
         arr[...] = arrays[k]
 
 
