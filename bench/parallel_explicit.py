@@ -7,6 +7,7 @@ ranks), each rank's peak RSS and, against a serial run
 saved with ``--save``, whether the damage, crack openings and displacements are the same bit
 for bit and the largest relative difference of the dissipation history.
 
+``--nonlocal R`` runs the nonlocal equivalent strain of radius R [m] (``rkfx.fracture.nonlocal_average``).
 ``--fem H`` runs the crack-band finite elements of element size H [m] instead
 (``fem_baselines.crack_band_dynamics``; on several ranks its time loop is distributed too).
 
@@ -41,6 +42,8 @@ def main() -> None:
     ap.add_argument("--nodes", type=int, default=450, help="particles per side")
     ap.add_argument("--t-end", type=float, default=80e-6, help="end time [s]")
     ap.add_argument("--fem", type=float, help="run the crack-band FEM of this element size [m] instead")
+    ap.add_argument("--nonlocal", type=float, default=0.0, dest="radius",
+                    help="run the nonlocal equivalent strain of this radius R [m] (0: the local law)")
     ap.add_argument("--save", help="write the run's results (rank 0) to this .npz file")
     ap.add_argument("--compare", help="compare with the results saved by --save")
     args = ap.parse_args()
@@ -61,7 +64,7 @@ def main() -> None:
         run, n, what = fem.run, fem.num_cells, "cells"
         setup = fem.wall_time_s - run.wall_time_s
     else:
-        pl, track, model = k.setup(args.nodes, material, prm, comm=comm)
+        pl, track, model = k.setup(args.nodes, material, prm, comm=comm, nonlocal_radius=args.radius)
         setup = time.perf_counter() - t0
         run = dyn.simulate("bench", pl, model, track, k.model_conditions(pl, prm["v0"]), args.t_end, comm=comm)
         n, what = pl.p.num_nodes, "particles"

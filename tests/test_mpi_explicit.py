@@ -130,8 +130,9 @@ def test_branching_crack_band_fem_on_two_ranks_is_the_serial_run(tmp_path):
 
 
 def test_nonlocal_branching_on_ranks_is_the_serial_run(tmp_path):
-    """The nonlocal equivalent strain on ranks (the averages read every rank's strains through
-    one all-gather per step): the same damaged particles, damage and openings on 2 and 3 ranks."""
+    """The nonlocal equivalent strain on ranks (the averages read the strains of the particles
+    within R through a halo exchange per step): the same damaged particles, damage and openings
+    on 2 and 3 ranks."""
     args = ["-m", "rkfx.cases.crack_branching", "--method", "rkpm", "--set", "h=1.6e-3", "unregularized_h=1.6e-3",
             "nonlocal_h=1.6e-3", "nonlocal_radius=3.2e-3", "t_end=5e-5"]
     mpiexec(1, *args, "--out", str(tmp_path / "serial"))

@@ -14,9 +14,9 @@ on the rank's local vectors as it would serially; per step the ranks exchange:
   boundaries; each rank keeps only the neighbour sets that reach its particles
   (``Tracking.near``); how many initiated on each rank is one all-gather of a count per step
   (with tracking on);
-* with the nonlocal equivalent strain (``rkfx.fracture.nonlocal_average``), every rank's
-  strains and failed flags (two all-gathers of one number per particle), which the averages
-  of the rank's allowed particles read;
+* with the nonlocal equivalent strain (``rkfx.fracture.nonlocal_average``), the strains and
+  failed flags of the particles within R of the rank's own (two neighbour-only halo exchanges
+  over that wider ghost layer), which the averages of the rank's allowed particles read;
 * the energies and the history samples (all-reduces of a few numbers).
 
 The constraint rows are replicated (the columns of G are ghosts everywhere), so every rank
@@ -33,9 +33,12 @@ import numpy as np
 
 from rkfx.assembly.local_strain import LocalNodes, local_smeared_strain
 from rkfx.assembly.matrix_strain import MatrixStrain, local_matrix_strain
+from rkfx.errors import InputError
 from rkfx.fracture.damage import DamageModel, initiate
+from rkfx.fracture.nonlocal_average import NonlocalAverage
 from rkfx.fracture.tracking import Tracking, admit
 from rkfx.models.damage_dynamics import DamageDynamics, DamageForce, damage_field
+from rkfx.parallel.halo import halo
 from rkfx.solvers.central_difference import Constraint, ExplicitDynamics
 
 
@@ -77,16 +80,16 @@ class RankDamageForce(DamageForce):
     are the serial ones."""
 
     def __init__(self, op: LocalNodes, model: DamageModel, local_model: DamageModel, field,
-                 track: Tracking | None, dt: float, comm):
+                 track: Tracking | None, dt: float, comm, part: np.ndarray | None = None):
         tracked = track is not None and track.enabled
+        if local_model.nonlocal_average is not None:
+            local_model = replace(local_model, nonlocal_average=self._nonlocal_halo(
+                local_model.nonlocal_average, np.asarray(op.points, np.int64), part, comm))
         super().__init__(op, local_model, field, track.near(op.points) if tracked else track, dt)
         self.whole, self.comm = model, comm
         self.tracked = tracked
         if tracked:
             field.allowed[:] = track.seeds[op.points]
-        if model.nonlocal_average is not None:  # the ranks' points, in rank order, for the gathers
-            self._point_counts = np.array(comm.allgather(len(op.points)), np.int64)
-            self._every_point = np.concatenate(comm.allgather(np.asarray(op.points, np.int64)))
         self._counts = np.zeros(comm.size, np.int64)
         self._one = np.zeros(1, np.int64)
 
@@ -106,16 +109,33 @@ class RankDamageForce(DamageForce):
         self.comm.Allgatherv(mine, [every, 4 * self._counts])
         return every[:, 0].astype(np.int64), np.ascontiguousarray(every[:, 1:3]), every[:, 3].astype(np.int64)
 
+    def _nonlocal_halo(self, average: NonlocalAverage, points: np.ndarray, part: np.ndarray | None,
+                       comm) -> NonlocalAverage:
+        """``average`` (the rows of ``points``, columns the particles' global indices) on the
+        numbering of the particles it reads: the rank's own ``points`` first, then the others
+        by owning rank (``part``: the rank of every particle); sets up their halo (collective)."""
+        if part is None:
+            raise InputError("a distributed nonlocal damage model needs the rank of every particle (part)")
+        others = np.setdiff1d(np.unique(average.indices), points)
+        others = others[np.argsort(np.asarray(part)[others], kind="stable")]
+        read = np.concatenate([points, others])
+        self._average_halo = halo(read, np.asarray(part)[read], comm)
+        self._values = np.zeros(len(read))
+        self._failed = np.zeros(len(read), np.bool_)
+        order = np.argsort(read, kind="stable")
+        local = order[np.searchsorted(read[order], average.indices)].astype(np.int32)
+        return NonlocalAverage(average.radius, average.band_factor, average.indptr, local, average.weights)
+
     def _nonlocal_inputs(self) -> tuple[np.ndarray, np.ndarray]:
-        """The equivalent strains and failed flags of every particle, gathered (collective: one
-        all-gather of the ranks' strains and one of their flags per step)."""
-        counts = self._point_counts
-        eq, failed = np.empty(int(counts.sum())), np.empty(int(counts.sum()), np.bool_)
-        self.comm.Allgatherv(self._eq, [eq, counts])
-        self.comm.Allgatherv(self.field.damage >= 1.0, [failed, counts])
-        values, flags = np.empty_like(eq), np.empty_like(failed)
-        values[self._every_point], flags[self._every_point] = eq, failed
-        return values, flags
+        """The equivalent strains and failed flags of the particles the rank's averages read:
+        its own, and the others' from their owners (collective over the neighbours: one halo
+        exchange of the strains and one of the flags per step)."""
+        n = len(self._eq)
+        self._values[:n] = self._eq
+        np.greater_equal(self.field.damage, 1.0, out=self._failed[:n])
+        self._average_halo.exchange(self._values)
+        self._average_halo.exchange(self._failed)
+        return self._values, self._failed
 
     def _initiate_all(self, new: np.ndarray) -> None:
         f, points = self.field, self.op.points
@@ -156,7 +176,8 @@ class RankDamage(DamageDynamics):
         points, dofs = local.points, local.dofs
         self.op, self.damage_model = local, restricted(model, points)
         self.field = damage_field(self.damage_model, None, dt)
-        self.force = RankDamageForce(local, model, self.damage_model, self.field, track, dt, comm)
+        self.force = RankDamageForce(local, model, self.damage_model, self.field, track, dt, comm, part)
+        self.damage_model = self.force.model  # its nonlocal rows numbered over the particles they read
         essential = [Constraint(_columns(c.G, local), c.displacement, c.velocity) for c in constraints]
         f_ext = None if external_force is None else (lambda t: np.asarray(external_force(t))[dofs])
         ExplicitDynamics.__init__(self, np.asarray(mass)[dofs], self.force, dt, f_ext, essential,
