@@ -142,26 +142,39 @@ def nonlocal_average(x: np.ndarray, volume: np.ndarray, radius: float, band_fact
         raise InputError(f"nonlocal radius {radius:g} m is below 1.5 particle spacings ({1.5 * h:g} m): "
                          "refine the particles or enlarge the radius")
     indptr, indices = support_neighbours(x, np.full(len(x), float(radius)), x)
-    row = np.repeat(np.arange(len(x)), np.diff(indptr))
-    r2 = np.sum((x[row] - x[indices]) ** 2, axis=1) / radius**2
-    w = np.clip(1.0 - r2, 0.0, None) ** 2 * volume[indices]
-    if cracks is not None and len(cracks):
-        w[_crossing(x[row], x[indices], np.asarray(cracks, float).reshape(-1, 2, 2))] = 0.0
+    segments = np.zeros((0, 2, 2)) if cracks is None else np.ascontiguousarray(cracks, float).reshape(-1, 2, 2)
+    w = np.empty(len(indices))
+    _bell_weights(indptr, indices, x, volume, float(radius) ** 2, segments, w)
     return NonlocalAverage(float(radius), float(band_factor), indptr, indices, w)
 
 
-def _crossing(a: np.ndarray, b: np.ndarray, segments: np.ndarray) -> np.ndarray:
-    """Whether each segment a-b properly crosses one of ``segments``."""
-    def cross(u, v):
-        return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
+@numba.njit(cache=True, inline="always")
+def _cross(ux, uy, vx, vy):
+    return ux * vy - uy * vx
 
-    hit = np.zeros(len(a), bool)
-    for c, d in segments:
-        ab = b - a
-        o1, o2 = cross(ab, c - a), cross(ab, d - a)
-        o3, o4 = cross(d - c, a - c), cross(d - c, b - c)
-        hit |= (o1 * o2 < 0) & (o3 * o4 < 0)
-    return hit
+
+@numba.njit(parallel=True, cache=True)
+def _bell_weights(indptr, indices, x, volume, radius2, segments, out):
+    """out[e] = (1 - r^2 / R^2)^2 V_J of every entry e = (L, J) of the rows (0 beyond R, and 0
+    where the segment x_L-x_J properly crosses one of ``segments``: the pair sits on the two
+    sides of a crack), one pass without temporaries."""
+    for i in numba.prange(len(indptr) - 1):
+        ax, ay = x[i, 0], x[i, 1]
+        for e in range(indptr[i], indptr[i + 1]):
+            j = indices[e]
+            bx, by = x[j, 0], x[j, 1]
+            r2 = ((ax - bx) ** 2 + (ay - by) ** 2) / radius2
+            w = max(1.0 - r2, 0.0) ** 2 * volume[j]
+            abx, aby = bx - ax, by - ay
+            for k in range(segments.shape[0]):
+                cx, cy, dx, dy = segments[k, 0, 0], segments[k, 0, 1], segments[k, 1, 0], segments[k, 1, 1]
+                o1 = _cross(abx, aby, cx - ax, cy - ay)
+                o2 = _cross(abx, aby, dx - ax, dy - ay)
+                o3 = _cross(dx - cx, dy - cy, ax - cx, ay - cy)
+                o4 = _cross(dx - cx, dy - cy, bx - cx, by - cy)
+                if o1 * o2 < 0 and o3 * o4 < 0:
+                    w = 0.0
+            out[e] = w
 
 
 @numba.njit(parallel=True, cache=True)
