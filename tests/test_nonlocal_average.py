@@ -46,6 +46,27 @@ def test_rows_average_constants_and_interior_linear_fields(square):
     assert np.count_nonzero(out != -1.0) == 2
 
 
+def test_rows_built_for_some_particles_are_the_whole_builds_rows(square):
+    """A rank builds the rows of its own particles only (points=): their share equals the
+    share of the whole build entry for entry, crack cuts included; the partial rows refuse to
+    average until a share is taken, and a share of other particles is refused."""
+    p, domains = square
+    crack = np.array([[[0.0, 0.5], [0.5, 0.5]]])
+    whole = nonlocal_average(p.x, domains.area, 0.2, 1.0, crack)
+    mine = np.flatnonzero(p.x[:, 0] > 0.4)
+    part = nonlocal_average(p.x, domains.area, 0.2, 1.0, crack, points=mine)
+    a, b = whole.restricted(mine), part.restricted(mine)
+    for name in ("indptr", "indices", "weights"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+    assert np.count_nonzero(b.weights == 0.0) > 0  # pairs across the crack are cut
+    with pytest.raises(InputError, match="restricted"):
+        part.average(np.zeros(p.num_nodes), mine, np.zeros(p.num_nodes))
+    with pytest.raises(InputError, match="other particles"):
+        part.restricted(np.array([0, 1]))
+    with pytest.raises(InputError, match="ascending"):
+        nonlocal_average(p.x, domains.area, 0.2, 1.0, points=mine[::-1])
+
+
 def test_a_lone_strained_particle_does_not_initiate_on_its_own_strain(square):
     """The history follows the average: a strain above kappa0 at one particle only, averaged with
     unstrained neighbours, stays below the threshold; a uniform one crosses it everywhere, with

@@ -52,6 +52,7 @@ VARIANTS = {  # name: the parameters that differ from the case's defaults
     "nonlocal R=2mm": {"nonlocal_radius": 2e-3},
     "nonlocal R=2mm eps_p=0": {"nonlocal_radius": 2e-3, "eps_p": 0.0},
     "nonlocal R=2mm eps_p=0.25": {"nonlocal_radius": 2e-3, "eps_p": 0.25},
+    "nonlocal R=2.5mm": {"nonlocal_radius": 2.5e-3},
     "nonlocal R=3mm": {"nonlocal_radius": 3e-3},
     "nonlocal R=2mm untracked": {"nonlocal_radius": 2e-3, "tracked": False},
     "nonlocal R=2mm eps_p=0 untracked": {"nonlocal_radius": 2e-3, "eps_p": 0.0, "tracked": False},

@@ -146,15 +146,17 @@ def plate(xs: np.ndarray, ys: np.ndarray, slits: Sequence, tips: Sequence[tuple[
 
 
 def damage_model(pl: Plate, material: dm.DamageMaterial, regularized: bool = True,
-                 kappa_c: float | None = None, nonlocal_radius: float = 0.0) -> dm.DamageModel:
+                 kappa_c: float | None = None, nonlocal_radius: float = 0.0, comm=None) -> dm.DamageModel:
     """The damage particles of the plate: regularized (4.28) on the cells, or a constant kappa_c;
     with ``nonlocal_radius`` > 0 [m] regularized by the nonlocal equivalent strain over that radius
-    instead (``rkfx.fracture.nonlocal_average``)."""
+    instead (``rkfx.fracture.nonlocal_average``; with an MPI ``comm`` of several ranks, the rows
+    of this rank's particles only, the part ``simulate`` will give it)."""
     geometry = dm.cell_geometry(pl.domains) if regularized else None
     model = dm.damage_model(material, pl.domains.area, geometry=geometry, kappa_c=kappa_c, regularized=regularized)
     if nonlocal_radius > 0 and regularized:
         factor = band_factor(material.E * material.GF / material.ft**2 / nonlocal_radius)
-        average = nonlocal_average(pl.p.x, model.volume, nonlocal_radius, factor, pl.cracks.segments)
+        mine = None if comm is None or comm.size == 1 else np.flatnonzero(rcb(pl.p.x, comm.size) == comm.rank)
+        average = nonlocal_average(pl.p.x, model.volume, nonlocal_radius, factor, pl.cracks.segments, mine)
         model = replace(model, nonlocal_average=average)
     return model
 

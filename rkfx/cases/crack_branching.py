@@ -189,7 +189,7 @@ def setup(h: float, material: dm.DamageMaterial, prm: dict, regularized: bool = 
                    prm["courant"], prm["eps_p"], comm)
     seeds = np.linalg.norm(pl.p.x - np.array([A1, A2]), axis=1) < 0.75 * pl.h
     track = tracking(pl.p.x, pl.p.spacing, prm["tol"], seeds, prm["radius"], forward=prm["forward"])
-    return (pl, track, dyn.damage_model(pl, material, regularized, kappa_c, nonlocal_radius),
+    return (pl, track, dyn.damage_model(pl, material, regularized, kappa_c, nonlocal_radius, comm),
             traction_force(pl, prm["sigma"]))
 
 

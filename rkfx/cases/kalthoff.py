@@ -203,7 +203,7 @@ def setup(n: int, material: dm.DamageMaterial, prm: dict, regularized: bool = Tr
     seeds = np.linalg.norm(pl.p.x - np.array([A1, A2]), axis=1) < 0.75 * pl.h
     track = tracking(pl.p.x, pl.p.spacing, prm["tol"], seeds, prm["radius"], enabled=tracked,
                      forward=prm["forward"])
-    return pl, track, dyn.damage_model(pl, material, regularized, kappa_c, nonlocal_radius)
+    return pl, track, dyn.damage_model(pl, material, regularized, kappa_c, nonlocal_radius, comm)
 
 
 def _rkpm(label, study, n, material, prm, regularized=True, kappa_c=None, tracked=True, nonlocal_radius=0.0,

@@ -46,6 +46,8 @@ class NonlocalAverage:
         band_factor: Band width b / R of the critical strain kappa_c = 2 G_F / (f_t b).
         indptr, indices, weights: CSR rows of w_LJ V_J, shapes ``(n + 1,)`` int64, ``(nnz,)`` int32
             and ``(nnz,)`` (normalized when averaging, over the particles taking part).
+        points: The particles whose rows these are, ascending (``None``: every particle, row L
+            of particle L): a rank of a distributed run builds those of its own particles only.
     """
 
     radius: float
@@ -53,6 +55,7 @@ class NonlocalAverage:
     indptr: np.ndarray
     indices: np.ndarray
     weights: np.ndarray
+    points: np.ndarray | None = None
 
     @property
     def band_width(self) -> float:
@@ -67,6 +70,8 @@ class NonlocalAverage:
         (a crack cuts the interaction across it), the weights renormalized over the rest; a
         row whose particles have all failed averages to 0.
         """
+        if self.points is not None:
+            raise InputError("these nonlocal rows are some particles' only: take a rank's share (restricted) first")
         rows = np.asarray(rows, np.int64)
         if failed is None:
             failed = np.zeros(len(values), np.bool_)
@@ -76,8 +81,14 @@ class NonlocalAverage:
         """The rows of ``points`` only (row k averages around particle ``points[k]``; the columns
         stay the particles' indices): one rank's share."""
         points = np.asarray(points, np.int64)
-        count = self.indptr[points + 1] - self.indptr[points]
-        at = ranges(self.indptr[points], count)
+        rows = points
+        if self.points is not None:  # rows held for some particles only: find theirs
+            rows = np.minimum(np.searchsorted(self.points, points), max(len(self.points) - 1, 0))
+            if len(points) and (len(self.points) == 0 or np.any(self.points[rows] != points)):
+                raise InputError("the nonlocal rows were built for other particles than this share's; "
+                                 "build them for these (nonlocal_average(..., points=))")
+        count = self.indptr[rows + 1] - self.indptr[rows]
+        at = ranges(self.indptr[rows], count)
         indptr = np.zeros(len(points) + 1, np.int64)
         np.cumsum(count, out=indptr[1:])
         return NonlocalAverage(self.radius, self.band_factor, indptr, self.indices[at], self.weights[at])
@@ -121,10 +132,11 @@ def band_factor(length_over_radius: float) -> float:
 
 
 def nonlocal_average(x: np.ndarray, volume: np.ndarray, radius: float, band_factor: float,
-                     cracks: np.ndarray | None = None) -> NonlocalAverage:
+                     cracks: np.ndarray | None = None, points: np.ndarray | None = None) -> NonlocalAverage:
     """The bell-weighted averaging rows of the particles ``x`` with volumes ``volume`` over ``radius``;
     pairs whose joining segment crosses one of the pre-existing ``cracks`` (segments, shape
-    ``(k, 2, 2)`` [m]) do not interact.
+    ``(k, 2, 2)`` [m]) do not interact. ``points``: build the rows of these particles only
+    (ascending; a rank's own), default all.
 
     Raises:
         InputError: a radius that is not positive, or one below the largest particle spacing
@@ -141,11 +153,14 @@ def nonlocal_average(x: np.ndarray, volume: np.ndarray, radius: float, band_fact
     if radius < 1.5 * h:
         raise InputError(f"nonlocal radius {radius:g} m is below 1.5 particle spacings ({1.5 * h:g} m): "
                          "refine the particles or enlarge the radius")
-    indptr, indices = support_neighbours(x, np.full(len(x), float(radius)), x)
+    rows = np.arange(len(x)) if points is None else np.asarray(points, np.int64)
+    if points is not None and np.any(np.diff(rows) <= 0):
+        raise InputError("nonlocal_average: points must be distinct particle indices in ascending order")
+    indptr, indices = support_neighbours(x, np.full(len(x), float(radius)), x[rows])
     segments = np.zeros((0, 2, 2)) if cracks is None else np.ascontiguousarray(cracks, float).reshape(-1, 2, 2)
     w = np.empty(len(indices))
-    _bell_weights(indptr, indices, x, volume, float(radius) ** 2, segments, w)
-    return NonlocalAverage(float(radius), float(band_factor), indptr, indices, w)
+    _bell_weights(indptr, indices, rows, x, volume, float(radius) ** 2, segments, w)
+    return NonlocalAverage(float(radius), float(band_factor), indptr, indices, w, None if points is None else rows)
 
 
 @numba.njit(cache=True, inline="always")
@@ -154,20 +169,21 @@ def _cross(ux, uy, vx, vy):
 
 
 @numba.njit(parallel=True, cache=True)
-def _bell_weights(indptr, indices, x, volume, radius2, segments, out):
-    """out[e] = (1 - r^2 / R^2)^2 V_J of every entry e = (L, J) of the rows (0 beyond R, and 0
-    where the segment x_L-x_J properly crosses one of ``segments``: the pair sits on the two
-    sides of a crack), one pass without temporaries."""
-    for i in numba.prange(len(indptr) - 1):
+def _bell_weights(indptr, indices, rows, x, volume, radius2, segments, out):
+    """out[e] = (1 - r^2 / R^2)^2 V_J of every entry e = (L, J) of the rows (row k: particle
+    L = rows[k]; 0 beyond R, and 0 where the segment x_L-x_J properly crosses one of
+    ``segments``: the pair sits on the two sides of a crack), one pass without temporaries."""
+    for k in numba.prange(len(indptr) - 1):
+        i = rows[k]
         ax, ay = x[i, 0], x[i, 1]
-        for e in range(indptr[i], indptr[i + 1]):
+        for e in range(indptr[k], indptr[k + 1]):
             j = indices[e]
             bx, by = x[j, 0], x[j, 1]
             r2 = ((ax - bx) ** 2 + (ay - by) ** 2) / radius2
             w = max(1.0 - r2, 0.0) ** 2 * volume[j]
             abx, aby = bx - ax, by - ay
-            for k in range(segments.shape[0]):
-                cx, cy, dx, dy = segments[k, 0, 0], segments[k, 0, 1], segments[k, 1, 0], segments[k, 1, 1]
+            for c in range(segments.shape[0]):
+                cx, cy, dx, dy = segments[c, 0, 0], segments[c, 0, 1], segments[c, 1, 0], segments[c, 1, 1]
                 o1 = _cross(abx, aby, cx - ax, cy - ay)
                 o2 = _cross(abx, aby, dx - ax, dy - ay)
                 o3 = _cross(dx - cx, dy - cy, ax - cx, ay - cy)
