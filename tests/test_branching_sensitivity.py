@@ -34,3 +34,15 @@ def test_the_untracked_variants_switch_the_tracking_off():
     assert study.VARIANTS["nonlocal R=2mm untracked"]["tracked"] is False
     plain, free = study.measure(1.6e-3, {}), study.measure(1.6e-3, {"tracked": False})
     assert free["dissipated"] > 0 and free["dissipated"] != plain["dissipated"]
+
+
+def test_the_crack_band_fem_is_measured_the_same_way():
+    """The crack-band FEM baseline on the same plate gives every measurement of the particle
+    runs, on its cells (no kappa_c ratio: the band has no chord)."""
+    m = study.measure(1.6e-3, study.VARIANTS["crack-band FEM"])
+    plain = study.measure(1.6e-3, {})
+    assert set(m) == set(plain)
+    assert m["particles"] > plain["particles"]  # triangles of size h outnumber the particles
+    assert m["crack"] > 0 and m["crack"] + m["onset"] == pytest.approx(m["dissipated"])
+    assert sum(m["onset_by_distance"]) == pytest.approx(m["onset"])
+    assert m["kappa_c_over_kappa0"] is None and m["branches"] >= 1

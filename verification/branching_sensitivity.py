@@ -1,6 +1,7 @@
 """How the crack-branching run at fine spacings responds to the method's parameters (issue: chapter 4
-at the finest resolutions). Measures, per spacing h and variant of one parameter, what the figure
-shows and where the energy goes:
+at the finest resolutions). Measures, per spacing h and variant of one parameter (or the
+crack-band finite elements of size h on the same plate, variant ``crack-band FEM``, their cells
+measured as the particles are), what the figure shows and where the energy goes:
 
 * branches: the case's count on x = 80-95 mm; side by side: ``most_cracks``;
 * x_two [mm]: the largest grid column crossed by two or more separate cracks (how far the
@@ -28,6 +29,7 @@ import sys
 import time
 from dataclasses import replace
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -56,56 +58,113 @@ VARIANTS = {  # name: the parameters that differ from the case's defaults
     "nonlocal R=3mm": {"nonlocal_radius": 3e-3},
     "nonlocal R=2mm untracked": {"nonlocal_radius": 2e-3, "tracked": False},
     "nonlocal R=2mm eps_p=0 untracked": {"nonlocal_radius": 2e-3, "eps_p": 0.0, "tracked": False},
+    "crack-band FEM": {"fem": True},
 }
+
+
+class _Fracture(NamedTuple):
+    """What one run leaves for the measurements: its damage points (particles or cells), their
+    final opening w / w_c, dissipation and history kappa / kappa0, the crack count of every
+    column x > a1 with the branch metrics, and the median kappa_c / kappa0 of the points that
+    initiated (``None`` where the law has no such ratio to report)."""
+
+    h: float
+    points: np.ndarray
+    opening: np.ndarray
+    dissipation: np.ndarray
+    kappa_ratio: np.ndarray
+    dissipated: float
+    columns: np.ndarray
+    counts: np.ndarray
+    branches: int
+    split: float
+    critical_ratio: float | None
+    steps: int
 
 
 def measure(h: float, overrides: dict) -> dict:
     """One regularized run of the case at spacing ``h`` [m] with ``overrides`` (case parameters,
-    ``residual``: the residual stiffness of the damage model, ``nonlocal_radius`` [m], and
-    ``tracked``: ``False`` lets every particle damage); its measurements."""
+    ``residual``: the residual stiffness of the damage model, ``nonlocal_radius`` [m],
+    ``tracked``: ``False`` lets every particle damage, and ``fem``: the crack-band finite
+    elements of size h instead of the particles); its measurements."""
     overrides = dict(overrides)
+    t0 = time.perf_counter()
+    run = _crack_band(h, overrides) if overrides.pop("fem", False) else _particles(h, overrides)
+    return _metrics(run) | {"h": h, "steps": run.steps, "wall_s": time.perf_counter() - t0}
+
+
+def _material(prm: dict) -> dm.DamageMaterial:
+    return dm.DamageMaterial(prm["E"], prm["nu"], prm["ft"], prm["GF"], prm["plane"])
+
+
+def _particles(h: float, overrides: dict) -> _Fracture:
+    """The damage particle method's run (the case's ``rkpm-dpm``, or its nonlocal study)."""
     residual = overrides.pop("residual", 0.0)
     radius = overrides.pop("nonlocal_radius", None)
     tracked = overrides.pop("tracked", True)
     prm = {k: p.default for k, p in cb.PARAMS.items()} | overrides
-    material = dm.DamageMaterial(prm["E"], prm["nu"], prm["ft"], prm["GF"], prm["plane"])
-    t0 = time.perf_counter()
+    material = _material(prm)
     pl, track, model, f = cb.setup(h, material, prm, nonlocal_radius=radius or 0.0)
     model = replace(model, residual=residual)
     track = track if tracked else replace(track, enabled=False)
     r = dyn.simulate("study", pl, model, track, [], prm["t_end"], external_force=lambda t: f)
     branches, split, counts = cb.branch_metrics(r.opening, pl.xs, pl.ys)
-    columns = pl.xs[pl.xs > cb.A1]
-    two = columns[counts >= 2]
-    cracked = r.opening >= dyn.CRACKED
-    x = pl.p.x
-    mid = cracked & (np.abs(x[:, 1] - cb.A2) < 2 * pl.h) & (x[:, 0] > (split if np.isfinite(split) else cb.A1))
-    crack = float(r.dissipation[cracked].sum())
-    # Where the onset energy sits: distance of each uncracked particle to the nearest cracked one.
-    rest = np.flatnonzero(~cracked & (r.dissipation > 0))
-    far = cKDTree(x[cracked]).query(x[rest])[0] if cracked.any() and rest.size else np.zeros(rest.size)
-    bands = [float(r.dissipation[rest][(far >= lo) & (far < hi)].sum()) for lo, hi in ONSET_BANDS]
-    flank = rest[far < ONSET_BANDS[0][1]]  # the uncracked particles beside the cracks
-    flank_w = float(np.median(r.opening[flank])) if flank.size else None
-    flank_kappa = float(np.median(r.kappa[flank] / model.kappa0[flank])) if flank.size else None
     started = np.flatnonzero(r.kappa > model.kappa0)  # the particles that initiated
     chords = dm.chord_lengths(model.geometry, started, r.normal[started])
     ratio = dm.critical_strain(material, chords, model.volume[started]) / model.kappa0[started]
     if model.nonlocal_average is not None:  # the band's kappa_c (rkfx.fracture.nonlocal_average)
         kc = 2.0 * material.GF / (material.ft * model.nonlocal_average.band_width)
         ratio = kc / model.kappa0[started]
-    return {"h": h, "particles": pl.p.num_nodes, "branches": branches, "side_by_side": cb._most_cracks(counts, columns),
+    return _Fracture(pl.h, pl.p.x, r.opening, r.dissipation, r.kappa / model.kappa0, float(r.history[-1, 1]),
+                     pl.xs[pl.xs > cb.A1], counts, branches, split, float(np.median(ratio)) if ratio.size else None,
+                     r.steps)
+
+
+def _crack_band(h: float, overrides: dict) -> _Fracture:
+    """The crack-band finite elements of size ``h`` on the same plate (the case's ``fem``: gmsh
+    triangles, no tracking), their cells measured as the particles are."""
+    import dolfinx_solver  # noqa: F401, PLC0415 (before dolfinx)
+
+    from fem_baselines.crack_band_dynamics import branching_crack_band  # noqa: PLC0415
+
+    prm = {k: p.default for k, p in cb.PARAMS.items()} | overrides
+    res = branching_crack_band(h, prm["t_end"], E=prm["E"], nu=prm["nu"], rho=prm["rho"], ft=prm["ft"], GF=prm["GF"],
+                               sigma=prm["sigma"], plane=prm["plane"], width=cb.LX, height=cb.LY, a1=cb.A1, a2=cb.A2,
+                               courant=prm["courant"], label="study")
+    r = res.run
+    columns = np.arange(cb.A1 + 0.5 * h, cb.LX, h)  # as the case counts the crack band's branches
+    counts = dyn.count_branches(res.centroids, r.opening, columns, h, 3.0 * h)
+    kappa0 = prm["ft"] / prm["E"]
+    return _Fracture(h, res.centroids, r.opening, r.dissipation, r.kappa / kappa0, float(r.history[-1, 1]),
+                     columns, counts, *cb._branches(counts, columns), None, r.steps)
+
+
+def _metrics(run: _Fracture) -> dict:
+    """The measurements of the module docstring, from one run."""
+    two = run.columns[run.counts >= 2]
+    cracked = run.opening >= dyn.CRACKED
+    x, split = run.points, run.split
+    mid = cracked & (np.abs(x[:, 1] - cb.A2) < 2 * run.h) & (x[:, 0] > (split if np.isfinite(split) else cb.A1))
+    crack = float(run.dissipation[cracked].sum())
+    # Where the onset energy sits: distance of each uncracked point to the nearest cracked one.
+    rest = np.flatnonzero(~cracked & (run.dissipation > 0))
+    far = cKDTree(x[cracked]).query(x[rest])[0] if cracked.any() and rest.size else np.zeros(rest.size)
+    bands = [float(run.dissipation[rest][(far >= lo) & (far < hi)].sum()) for lo, hi in ONSET_BANDS]
+    flank = rest[far < ONSET_BANDS[0][1]]  # the uncracked points beside the cracks
+    return {"h": run.h, "particles": len(x), "branches": run.branches,
+            "side_by_side": cb._most_cracks(run.counts, run.columns),
             "x_two_mm": 1e3 * float(two.max()) if two.size else None,
             "split_mm": 1e3 * split if np.isfinite(split) else None,
             "mid_plane_mm": 1e3 * float(np.ptp(x[mid, 0])) if mid.sum() > 1 else 0.0,
-            "dissipated": float(r.history[-1, 1]), "crack": crack, "onset": float(r.history[-1, 1]) - crack,
-            "kappa_c_over_kappa0": float(np.median(ratio)) if ratio.size else None,
+            "dissipated": run.dissipated, "crack": crack, "onset": run.dissipated - crack,
+            "kappa_c_over_kappa0": run.critical_ratio,
             "onset_by_distance": bands, "flank_per_cracked": flank.size / max(1, int(cracked.sum())),
-            "flank_opening": flank_w, "flank_kappa_over_kappa0": flank_kappa, "steps": r.steps, "wall_s": time.perf_counter() - t0}
+            "flank_opening": float(np.median(run.opening[flank])) if flank.size else None,
+            "flank_kappa_over_kappa0": float(np.median(run.kappa_ratio[flank])) if flank.size else None}
 
 
 ROW = ("| {h:.1f} | {variant} | {branches} | {side_by_side} | {split} | {x_two} | {mid_plane_mm:.1f} | "
-       "{dissipated:.3f} | {crack:.3f} | {onset:.3f} | {share:.0%} | {bands} | {kappa_c_over_kappa0:.1f} | "
+       "{dissipated:.3f} | {crack:.3f} | {onset:.3f} | {share:.0%} | {bands} | {ratio} | "
        "{wall_s:.0f} |")
 
 
@@ -161,6 +220,7 @@ def main(argv=None) -> int:
             print(ROW.format(**{**m, "h": 1e3 * h, "split": "-" if m["split_mm"] is None else f"{m['split_mm']:.1f}",
                                 "x_two": "-" if m["x_two_mm"] is None else f"{m['x_two_mm']:.1f}",
                                 "share": m["onset"] / m["dissipated"],
+                                "ratio": "-" if m["kappa_c_over_kappa0"] is None else f"{m['kappa_c_over_kappa0']:.1f}",
                                 "bands": " / ".join(f"{v:.3f}" for v in m["onset_by_distance"])}), flush=True)
     return 0
 
