@@ -349,8 +349,11 @@ class _Samples:
         e = s.energy
         # The strain energy still stored, d . f_int(d) / 2: the force is linear in d at the
         # step's damage (max(1 - D, eta) of the cell and MSCNI terms alike).
+        # (An elementwise product and sum, not a BLAS dot: the BLAS threads would spin beside
+        # numba's after every sample.)
         d = s.d if self.owned is None else s.d * self.owned
-        damage = np.array([self.field.dissipated(self.model), self.field.damaged.sum(), 0.5 * float(d @ s.f_int)])
+        stored = 0.5 * float(np.multiply(d, s.f_int).sum())
+        damage = np.array([self.field.dissipated(self.model), self.field.damaged.sum(), stored])
         if self.total is not None:
             damage = self.total(damage)
         self.history[self.slot[0]] = (s.time, damage[0], damage[1], e[0], e[1], e[2] + e[3], damage[2])
