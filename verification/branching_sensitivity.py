@@ -132,8 +132,7 @@ def _crack_band(h: float, overrides: dict) -> _Fracture:
                                sigma=prm["sigma"], plane=prm["plane"], width=cb.LX, height=cb.LY, a1=cb.A1, a2=cb.A2,
                                courant=prm["courant"], label="study")
     r = res.run
-    columns = np.arange(cb.A1 + 0.5 * h, cb.LX, h)  # as the case counts the crack band's branches
-    counts = dyn.count_branches(res.centroids, r.opening, columns, h, 3.0 * h)
+    columns, counts = cb.cell_branch_counts(res.centroids, r.opening, h)  # as the case counts them
     kappa0 = prm["ft"] / prm["E"]
     return _Fracture(h, res.centroids, r.opening, r.dissipation, r.kappa / kappa0, float(r.history[-1, 1]),
                      columns, counts, *cb._branches(counts, columns), None, r.steps)

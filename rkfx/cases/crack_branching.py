@@ -210,6 +210,13 @@ def branch_metrics(opening: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> tuple
     return (*_branches(counts, columns), counts)
 
 
+def cell_branch_counts(centroids: np.ndarray, opening: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
+    """(columns, counts) of the crack-band cells of size ``h``: columns x every h beyond a1 and
+    the crack count of each (runs of cracked cells more than three sizes apart are separate)."""
+    columns = np.arange(A1 + 0.5 * h, LX, h)
+    return columns, dyn.count_branches(centroids, opening, columns, h, 3.0 * h)
+
+
 def _most_cracks(counts: np.ndarray, column_x: np.ndarray) -> int:
     return dyn.most_cracks(column_x, counts, SIDE_BY_SIDE)
 
@@ -260,8 +267,7 @@ def _fem(h: float, prm: dict, io: dict) -> Run:
                                courant=prm["courant"], label=label,
                                frames=_paraview.crack_band_frames(io.pop("vtk"), label, io.get("comm")), **io)
     r = res.run
-    columns = np.arange(A1 + 0.5 * h, LX, h)
-    counts = dyn.count_branches(res.centroids, r.opening, columns, h, 3.0 * h)
+    columns, counts = cell_branch_counts(res.centroids, r.opening, h)
     cracked = r.opening >= dyn.CRACKED
     tip_x = float(res.centroids[cracked, 0].max()) if cracked.any() else float("nan")
     series = dyn.run_series(r)
