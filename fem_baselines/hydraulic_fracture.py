@@ -26,6 +26,15 @@ element e:
   ``rkfx.models.hydro_damage.crack_permeability`` (the RKPM model's call): along the crack
   k_fC = w^3 / (12 mu_f L_s) (5.12) with w = D L_s max(n . eps . n, 0) (5.13), k_f0 across.
 
+* a pre-existing fracture (``contact``, ``fracture``): the mesh is cut along it (its vertices
+  the particles of ``rkfx.geometry.particles.cut_triangulation``), its faces are paired node
+  to node (``fem_baselines.fracture_faces``) and carry the penalty frictional contact
+  (5.38)-(5.39) of ``rkfx.fracture.contact`` and the fluid pressure, its tangent and pressure
+  coupling join the Jacobian, its slip is history; the elements touching its faces carry its
+  permeability (open: (5.8) with w = g_N; closed: k_f0 / 100), as the particles covering it do
+  in the RKPM model. Tractions and fluxes on boundary parts are the loads of
+  ``fem_baselines.poroelasticity.NaturalLoads``.
+
 Band width. L_s = h_e = the width of the element measured along its crack normal n,
 max(n . x_v) - min(n . x_v) over its vertices (equivalently its area over its mean chord along
 the crack, for a triangle A_e / (L_max / 2) with L_max its longest chord parallel to the
@@ -163,10 +172,13 @@ import ufl
 
 from fem_baselines.conditions import BoundaryParts, check_kinds
 from fem_baselines.elasticity import strain, stress_law
-from fem_baselines.poroelasticity import _gather, _global_matrix, _global_vector, _in_order, _Sampler, rectangle_mesh
-from rkfx.conditions import Condition, Displacement, Pressure, Region, values
+from fem_baselines.fracture_faces import FractureFaces, nodal_interface, touching
+from fem_baselines.poroelasticity import (NaturalLoads, _gather, _global_matrix, _global_vector, _in_order, _Sampler,
+                                          rectangle_mesh)
+from rkfx.conditions import Condition, Displacement, Flux, Pressure, Region, Traction, values
 from rkfx.errors import InputError, SolverError
 from rkfx.fracture import damage as dm
+from rkfx.fracture.contact import FractureContact, FrictionalContact
 from rkfx.fracture.history import DamageHistory
 from rkfx.fracture.tracking import tracking
 from rkfx.linalg.linear_solver import Factorizations
@@ -258,7 +270,8 @@ class FemHydraulicFractureModel(DamageHistory):
         rock: The material (``FracturingRock``).
         conditions: ``Displacement`` and ``Pressure`` of ``rkfx.conditions`` on boundary parts
             (names, tags or markers as ``fem_baselines.conditions``) or on a ``Region``: every
-            dof whose point the region's marker accepts (a notch inside the domain).
+            dof whose point the region's marker accepts (a notch inside the domain); ``Traction``
+            (total stress) and ``Flux`` on boundary parts.
         precracked: Elements damaged from the start (D = 1): those whose three vertices the
             region's marker accepts; ``None``: none.
         precrack_normal: Their crack normal (unit).
@@ -275,6 +288,11 @@ class FemHydraulicFractureModel(DamageHistory):
         injection: ``(region, rate)``: fluid injected at ``rate(t)`` [m^2/s per metre of
             thickness] into the elements whose three vertices the region's marker accepts,
             spread evenly over their area (the RKPM model's ``injection``, shared by volume).
+        contact, fracture: A pre-existing fracture (P1 only): the frictional contact law
+            (5.38)-(5.39) of ``rkfx.fracture.contact`` on the vertex pairs of a mesh cut along it
+            (``fem_baselines.fracture_faces``); the elements with a vertex on its faces carry its
+            flow (open: (5.8) with w = g_N; closed: k_f0 / 100), as the RKPM model's particles
+            covering it do. ``None``: no such fracture.
 
     Attributes:
         committed: The committed ``rkfx.fracture.damage.DamageState`` of the elements (element
@@ -284,6 +302,9 @@ class FemHydraulicFractureModel(DamageHistory):
         points: The damage points (``DamageModel``): volumes = element areas.
         vertices: Vertices of every element, shape ``(m, 3, 2)`` [m]; ``area`` ``(m,)`` [m^2].
         precracked: Pre-cracked elements, shape ``(m,)`` bool.
+        u_nodes, p_nodes: Coordinates of the nodes of V and Q in global order, shapes
+            ``(n_u / 2, 2)`` and ``(n_p, 2)`` [m].
+        fracture: The pre-existing fracture's ``FractureContact`` (or ``None``).
     """
 
     linear = False
@@ -293,7 +314,8 @@ class FemHydraulicFractureModel(DamageHistory):
                  element: str = "p1p1-fpp", mass: str = "lumped", jacobian: str = "full",
                  residual: float = RESIDUAL_STIFFNESS, track: tuple[float, float] | None = None,
                  damage_update: str = "implicit",
-                 injection: tuple[Region, Callable[[float], float]] | None = None):
+                 injection: tuple[Region, Callable[[float], float]] | None = None,
+                 contact: FrictionalContact | None = None, fracture: FractureFaces | None = None):
         if not isinstance(rock, FracturingRock):
             raise InputError(f"rock = {rock!r}: give a rkfx.models.hydraulic_fracture.FracturingRock")
         if element not in ELEMENTS:
@@ -311,7 +333,12 @@ class FemHydraulicFractureModel(DamageHistory):
         if mesh.geometry.dim != 2 or mesh.topology.cell_type != dolfinx.mesh.CellType.triangle:
             raise InputError("the crack-band u-p baseline needs a 2-D mesh of triangles; mesh the plate with "
                              "fem_baselines.poroelasticity.rectangle_mesh(xs, ys, 'triangle')")
-        kinds = check_kinds(conditions, (Displacement, Pressure), "the crack-band u-p FEM")
+        kinds = check_kinds(conditions, (Displacement, Pressure, Traction, Flux), "the crack-band u-p FEM")
+        if (contact is None) != (fracture is None):
+            raise InputError("a pre-existing fracture needs both contact= (the law) and fracture= (its faces)")
+        if contact is not None and element != "p1p1-fpp":
+            raise InputError(f"element = {element!r}: the pre-existing fracture's node-to-node contact needs P1 "
+                             "displacements; use element='p1p1-fpp'")
         if not kinds[Displacement]:
             raise InputError("no Displacement condition: the rigid motions are free; fix a part of the boundary")
         self.comm, self.rock, self.element, self.mass_kind = mesh.comm, rock, element, mass
@@ -332,6 +359,8 @@ class FemHydraulicFractureModel(DamageHistory):
         self._e_index = e_map.local_to_global(np.arange(e_map.size_local + e_map.num_ghosts, dtype=np.int32))
         self.layout = FieldLayout((Field("u", 2, 2, v_map.size_global), Field("p", 1, 1, q_map.size_global)))
         self.n_dofs = self.n_u + self.n_p
+        self.u_nodes = _gather(self.comm, self.V.tabulate_dof_coordinates()[:v_map.size_local, :2])
+        self.p_nodes = _gather(self.comm, self.Q.tabulate_dof_coordinates()[:q_map.size_local, :2])
         self._element_data(mesh)
         self._forms(mesh)
         self.points = dm.damage_model(rock.damage_material, self.area, geometry=band_geometry(self.vertices),
@@ -358,6 +387,12 @@ class FemHydraulicFractureModel(DamageHistory):
         self.strain = np.zeros((self.m, 3))
         self.boundary = BoundaryParts(mesh)
         self._essential(mesh, kinds[Displacement] + kinds[Pressure])
+        self._natural = NaturalLoads(mesh, self.boundary, self.V, self.Q, kinds[Traction], kinds[Flux]) \
+            if kinds[Traction] or kinds[Flux] else None
+        self._loads_at: tuple[float, np.ndarray] | None = None
+        if contact is not None:
+            self.fracture = FractureContact(nodal_interface(fracture, self.u_nodes, self.p_nodes), contact,
+                                            self.centroids, self.area, carriers=touching(fracture, self.vertices))
         self._mass = self._assemble_mass()
         self._per_step = PerStepSize(keep=2)
         self._capacity: tuple[float, dm.DamageState, sp.csr_matrix] | None = None
@@ -518,9 +553,25 @@ class FemHydraulicFractureModel(DamageHistory):
         return w
 
     def permeability(self, state: dm.DamageState, eps: np.ndarray) -> np.ndarray:
-        """k_f (5.8) of every element, shape ``(m, 2, 2)`` [m^2/(Pa s)]."""
-        return crack_permeability(self.rock.mobility, state.damage, CrackBands(_unit(state.normal),
-                                  self.band_widths(state)), eps, self.rock.viscosity)
+        """k_f (5.8) of every element, shape ``(m, 2, 2)`` [m^2/(Pa s)]: the crack bands' and, at
+        the elements next to a pre-existing fracture, the fracture's at the last residual."""
+        k = crack_permeability(self.rock.mobility, state.damage, CrackBands(_unit(state.normal),
+                               self.band_widths(state)), eps, self.rock.viscosity)
+        if self.fracture is not None:
+            self.fracture.added_permeability(k, self.rock.mobility, self.rock.viscosity)
+        return k
+
+    def element_pressures(self, x: np.ndarray) -> np.ndarray:
+        """The mean pressure of every element for the unknowns ``x`` [Pa], shape ``(m,)``."""
+        return (self._ct @ x[self.n_u:]) / self.area
+
+    def loads(self, t: float) -> np.ndarray:
+        """[F(t), Q(t)] of the tractions and fluxes (zero without them), shape ``(n_dofs,)``."""
+        if self._natural is None:
+            return np.zeros(self.n_dofs)
+        if self._loads_at is None or (self._loads_at[0] != t and self._natural.varies):
+            self._loads_at = (t, self._natural.assemble(t, self.n_u, self.n_dofs))
+        return self._loads_at[1]
 
     def opening(self, state: dm.DamageState | None = None) -> np.ndarray:
         """w / w_c = D kappa / kappa_c of every element (``rkfx.fracture.damage.crack_opening``), shape ``(m,)``."""
@@ -542,13 +593,16 @@ class FemHydraulicFractureModel(DamageHistory):
             self._kc = _global_matrix(self._a_kc, self.comm)
         else:
             self._kc = self._kc_constant
+        self._x = x
+        f_u = self._ku @ u - self._kc @ P
+        if self.fracture is not None:
+            f_u = f_u + self.fracture.forces(u, P)  # before the permeability: it reads the apertures
         k = self.permeability(st, eps)
         for fn, (i, j) in zip(self._k, ((0, 0), (0, 1), (1, 1))):
             self._set(fn, k[:, i, j])
         self._kh = _global_matrix(self._a_kh, self.comm)
-        self._x = x
         q_ext = 0.0 if self._injection is None else float(self._injection[1](t)) * self._injection[0]
-        return np.r_[self._ku @ u - self._kc @ P, self._kh @ P - q_ext]
+        return np.r_[f_u, self._kh @ P - q_ext] - self.loads(t)
 
     def _damage(self, eps: np.ndarray) -> dm.DamageUpdate:
         """The damage of the elements' strains ``eps``: the trial from the committed state with
@@ -577,8 +631,11 @@ class FemHydraulicFractureModel(DamageHistory):
             self.assign(self._x)
             force = _global_matrix(self._a_force, self.comm).tocsc()[:, on]
             k_u = (k_u - force @ self._rows(dd, on)).tocsr()
+        k_up = -self._kc
+        if self.fracture is not None:
+            k_u, k_up = k_u + self.fracture.stiffness(), k_up + self.fracture.pressure_coupling()
         k_pu = self._flow_derivative(on, dd) if self.jacobian == "full" else None
-        return sp.bmat([[k_u, -self._kc], [k_pu, self._kh]], format="csr")
+        return sp.bmat([[k_u, k_up], [k_pu, self._kh]], format="csr")
 
     def _flow_derivative(self, loading: np.ndarray, dd: np.ndarray) -> sp.csr_matrix | None:
         """d(K_H P)/dU (5.33) at the last residual, shape ``(n_p, n_u)``, or ``None`` where no

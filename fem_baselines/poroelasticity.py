@@ -88,6 +88,7 @@ from fem_baselines.conditions import BoundaryParts, check_kinds
 from fem_baselines.elasticity import strain, stress_law
 from fem_baselines.gmsh_mesh import mesh_parts
 from rkfx.conditions import Condition, Displacement, Flux, Pressure, Traction, values
+from rkfx.errors import InputError
 from rkfx.materials.elasticity import ElasticMaterial
 from rkfx.linalg.linear_solver import Factorizations
 from rkfx.models.poroelasticity import PoroMaterial, fpp_parameter
@@ -100,6 +101,8 @@ __all__ = [
     "BiotResult",
     "FemBiotModel",
     "rectangle_mesh",
+    "triangle_mesh",
+    "NaturalLoads",
     "solve_biot",
 ]
 
@@ -207,6 +210,28 @@ def rectangle_mesh(
     return dolfinx.mesh.create_mesh(comm, cells, domain, x)
 
 
+def triangle_mesh(x: np.ndarray, triangles: np.ndarray, comm: MPI.Comm | None = None) -> dolfinx.mesh.Mesh:
+    """A mesh of linear triangles whose vertices are exactly ``x`` (e.g. the particles of
+    ``rkfx.geometry``, cut along fractures), built on rank 0 and distributed by dolfinx.
+
+    Args:
+        x: Vertex coordinates, shape ``(n, 2)`` [m].
+        triangles: Vertex triples, shape ``(m, 3)``.
+        comm: MPI communicator; defaults to ``MPI.COMM_WORLD``.
+    """
+    comm = MPI.COMM_WORLD if comm is None else comm
+    x = np.asarray(x, dtype=np.float64)
+    tri = np.asarray(triangles, dtype=np.int64)
+    if x.ndim != 2 or x.shape[1] != 2 or tri.ndim != 2 or tri.shape[1] != 3 or len(tri) == 0:
+        raise InputError(f"vertices of shape {x.shape} and triangles of shape {tri.shape}: give (n, 2) and (m, 3)")
+    if tri.min() < 0 or tri.max() >= len(x):
+        raise InputError(f"triangles refer to vertices 0..{tri.max()} of {len(x)}")
+    if comm.rank != 0:
+        x, tri = np.zeros((0, 2)), np.zeros((0, 3), dtype=np.int64)
+    domain = ufl.Mesh(basix.ufl.element("Lagrange", "triangle", 1, shape=(2,)))
+    return dolfinx.mesh.create_mesh(comm, tri, domain, x)
+
+
 # --------------------------------------------------------------------------- helpers
 
 
@@ -293,6 +318,56 @@ def _in_order(comm: MPI.Comm, parts: list[np.ndarray]) -> np.ndarray:
     return np.concatenate([np.zeros(0)] + [r[i] for i in range(len(parts)) for r in ranks])
 
 
+class NaturalLoads:
+    """The natural conditions of a u-p model: F(t) of tractions, tested with the displacement
+    space V, and Q(t) of fluxes, tested with the pressure space Q, from ``rkfx.conditions``
+    ``Traction`` and ``Flux`` on boundary parts. The data are interpolated into Lagrange spaces
+    on the cells next to each part (tractions of V's degree, fluxes P2), at the first
+    assembly and again at every t where they are callables of t."""
+
+    def __init__(self, mesh: dolfinx.mesh.Mesh, boundary: BoundaryParts, V: dolfinx.fem.FunctionSpace,
+                 Q: dolfinx.fem.FunctionSpace, tractions: Sequence[Traction] = (), fluxes: Sequence[Flux] = ()):
+        self.comm, self.boundary = mesh.comm, boundary
+        self._data: list[tuple[dolfinx.fem.Function, Traction | Flux]] = []
+        gdim = mesh.geometry.dim
+        v, q = ufl.TestFunction(V), ufl.TestFunction(Q)
+        degree = V.ufl_element().embedded_superdegree
+        linear = {}
+        for what, parts, space, term in (("traction", tractions, ("Lagrange", degree, (gdim,)),
+                                          lambda f: ufl.inner(f, v)),
+                                         ("flux", fluxes, ("Lagrange", 2), lambda f: -f * q)):
+            if not parts:
+                continue
+            ds = ufl.Measure("ds", domain=mesh, subdomain_data=boundary.tags([b.boundary for b in parts], what))
+            W = dolfinx.fem.functionspace(mesh, space)
+            forms = []
+            for i, bc in enumerate(parts):
+                fn = dolfinx.fem.Function(W)
+                self._data.append((fn, bc))
+                forms.append(term(fn) * ds(i + 1))
+            linear[what] = dolfinx.fem.form(sum(forms[1:], forms[0]))
+        self._L_u, self._L_p = linear.get("traction"), linear.get("flux")
+        self._interpolated = False
+
+    @property
+    def varies(self) -> bool:
+        """Whether any load depends on t."""
+        return any(callable(bc.value) for _, bc in self._data)
+
+    def assemble(self, t: float, n_u: int, size: int) -> np.ndarray:
+        """[F(t), Q(t)] over ``size`` unknowns, the first ``n_u`` the displacements (collective)."""
+        for fn, bc in self._data:
+            if callable(bc.value) or not self._interpolated:
+                self.boundary.interpolate(fn, bc, t)
+        self._interpolated = True
+        f = np.zeros(size)
+        if self._L_u is not None:
+            f[:n_u] = _global_vector(self._L_u, self.comm)
+        if self._L_p is not None:
+            f[n_u:] = _global_vector(self._L_p, self.comm)
+        return f
+
+
 class FemBiotModel:
     """Biot's u-p equations assembled by dolfinx, as a model for the steppers of ``rkfx.solvers``.
 
@@ -345,7 +420,7 @@ class FemBiotModel:
         kinds = check_kinds(conditions, (Displacement, Pressure, Traction, Flux), "the Biot FEM", gdim=gdim)
         self.boundary = BoundaryParts(mesh, facet_tags, physical_groups)
         self._assemble(mesh)
-        self._natural_conditions(mesh, kinds[Traction], kinds[Flux])
+        self._natural = NaturalLoads(mesh, self.boundary, self.V, self.Q, kinds[Traction], kinds[Flux])
         self._essential_conditions(mesh, kinds[Displacement] + kinds[Pressure])
         self._t = float(t0)  # committed time (the seed form's step starts there)
         self._t_trial = self._t
@@ -386,27 +461,6 @@ class FemBiotModel:
             self._cell_area = area.array.copy()  # owned + ghost cells [m^2] (volumes [m^3] in 3-D)
             self._cell_area_global = _gather(comm, self._cell_area[: DG0.dofmap.index_map.size_local])
             self._m_eps = dolfinx.fem.form(self._eps_f * p * q * dx)
-
-    def _natural_conditions(self, mesh: dolfinx.mesh.Mesh, tractions: Sequence[Traction],
-                            fluxes: Sequence[Flux]) -> None:
-        """Forms of F(t) (tractions on a V-like space) and Q(t) (fluxes on P2), data Functions at t."""
-        self._load_data: list[tuple[dolfinx.fem.Function, Traction | Flux]] = []
-        v, q = ufl.TestFunction(self.V), ufl.TestFunction(self.Q)
-        linear = {}
-        for what, parts, space, term in (("traction", tractions, ("Lagrange", self._degree, (self.gdim,)),
-                                          lambda f: ufl.inner(f, v)),
-                                         ("flux", fluxes, ("Lagrange", 2), lambda f: -f * q)):
-            if not parts:
-                continue
-            ds = ufl.Measure("ds", domain=mesh, subdomain_data=self.boundary.tags([b.boundary for b in parts], what))
-            W = dolfinx.fem.functionspace(mesh, space)
-            forms = []
-            for i, bc in enumerate(parts):
-                fn = dolfinx.fem.Function(W)
-                self._load_data.append((fn, bc))
-                forms.append(term(fn) * ds(i + 1))
-            linear[what] = dolfinx.fem.form(sum(forms[1:], forms[0]))
-        self._L_u, self._L_p = linear.get("traction"), linear.get("flux")
 
     def _essential_conditions(self, mesh: dolfinx.mesh.Mesh, essential: Sequence[Displacement | Pressure]) -> None:
         """Unit rows G on the owned dofs of each Dirichlet condition, data evaluated at their coordinates."""
@@ -460,19 +514,8 @@ class FemBiotModel:
 
     def loads(self, t: float) -> np.ndarray:
         """[F(t), Q(t)], shape ``(size,)``."""
-        def build(t):
-            first = "loads" not in self._at
-            for fn, bc in self._load_data:
-                if callable(bc.value) or first:
-                    self.boundary.interpolate(fn, bc, t)
-            f = np.zeros(self.layout.size)
-            if self._L_u is not None:
-                f[: self._n_u] = _global_vector(self._L_u, self.comm)
-            if self._L_p is not None:
-                f[self._n_u:] = _global_vector(self._L_p, self.comm)
-            return f
-
-        return self._cached("loads", t, any(callable(bc.value) for _, bc in self._load_data), build)
+        return self._cached("loads", t, self._natural.varies,
+                            lambda t: self._natural.assemble(t, self._n_u, self.layout.size))
 
     def constraints(self, t: float) -> Constraints:
         def build(t):

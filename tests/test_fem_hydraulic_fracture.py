@@ -20,7 +20,7 @@ from mpi4py import MPI  # noqa: E402
 
 from fem_baselines import hydraulic_fracture as hf  # noqa: E402
 from fem_baselines.poroelasticity import FemBiotModel, rectangle_mesh  # noqa: E402
-from rkfx.conditions import Displacement, Flux, Pressure, Region  # noqa: E402
+from rkfx.conditions import Displacement, Pressure, Region, Velocity  # noqa: E402
 from rkfx.errors import InputError, SolverError  # noqa: E402
 from rkfx.fracture import damage as dm  # noqa: E402
 from rkfx.models.hydraulic_fracture import FracturingRock  # noqa: E402
@@ -318,8 +318,8 @@ def test_bad_input_is_refused_in_one_line():
         assert "\n" not in str(err.value)
     with pytest.raises(InputError, match="no Displacement"):
         hf.FemHydraulicFractureModel(mesh, ROCK, [Pressure("left")])
-    with pytest.raises(InputError, match="takes no Flux"):
-        hf.FemHydraulicFractureModel(mesh, ROCK, fixed + [Flux("right", 1.0)])
+    with pytest.raises(InputError, match="takes no Velocity"):
+        hf.FemHydraulicFractureModel(mesh, ROCK, fixed + [Velocity("right", 1.0)])
     with pytest.raises(InputError, match="holds no pressure"):
         hf.FemHydraulicFractureModel(mesh, ROCK, fixed + [Pressure(Region(lambda x: x[:, 0] > 9, "far"))])
     with pytest.raises(InputError, match="must divide"):

@@ -228,7 +228,7 @@ ROWS: list[Row] = [
                             ("pre-fracture outside the block", "offset=0.2"),
                             ("growth step above the pressure ramp", "dt=0.1"), ("zero friction", "mu=0"),
                             ("unknown damage update", "damage_update=explicit")], extra=("--method", "rkpm")),
-    Row("FEM baseline asked for", "blanton", ("--method", "fem")),
+    Row("negative contact penalty, FEM baseline", "blanton", ("--method", "fem", "--set", "penalty=-1")),
     Row("too big for memory", "blanton", ("--method", "rkpm", "--set", "h=1e-5")),
     *_case_rows("wave_column", [("unknown nodal rule", "rules=nsni,fem"), ("porosity 1", "porosity=1"),
                                 ("grains softer than the skeleton", "K_s=1e8"), ("Courant number above 1", "courant=1.5"),

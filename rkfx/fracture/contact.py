@@ -191,11 +191,11 @@ def interface(p: Particles, domains: NodalDomains, rk: RKApproximation, name: st
     jump = (up - um).tocsr()
     n = rk.num_nodes
     return Interface(points=pts_plus, weights=weights, normal=normal, tangent=tangent,
-                     jump_normal=_directional(jump, normal, n), jump_tangent=_directional(jump, tangent, n),
+                     jump_normal=directional_rows(jump, normal, n), jump_tangent=directional_rows(jump, tangent, n),
                      mean=(0.5 * (up + um)).tocsr(), plus=b.node[faces][plus], minus=b.node[faces][minus])
 
 
-def _directional(rows: sp.csr_matrix, direction: np.ndarray, n: int) -> sp.csr_matrix:
+def directional_rows(rows: sp.csr_matrix, direction: np.ndarray, n: int) -> sp.csr_matrix:
     """Rows of (sum_I R_qI u_I) . d_q over interleaved displacement coefficients, shape ``(m, 2 n)``."""
     coo = rows.tocoo()
     r = np.r_[coo.row, coo.row]
@@ -211,14 +211,18 @@ class FractureContact:
     """
 
     def __init__(self, fracture: Interface, law: FrictionalContact, x: np.ndarray | None = None,
-                 volume: np.ndarray | None = None):
-        """``x`` and ``volume`` (particle coordinates and volumes) give the fracture's flow
-        (``permeability``)."""
+                 volume: np.ndarray | None = None, carriers: np.ndarray | None = None):
+        """``x`` and ``volume`` (the coordinates and volumes of the points that carry the flow:
+        particles, or elements' centroids and areas) give the fracture's flow (``permeability``);
+        ``carriers`` are the indices of those that carry the fracture's (default: the nodes
+        whose shape functions reach it, ``Interface.covering``)."""
         self.interface, self.law = fracture, law
         self.cover = self.nearest = None
         self.band_width = 0.0
         if x is not None and volume is not None:
-            self.cover = fracture.covering()
+            self.cover = fracture.covering() if carriers is None else np.unique(np.asarray(carriers, np.int64))
+            if self.cover.size == 0:
+                raise InputError("no point carries the fracture's flow: give the elements or particles next to it")
             self.nearest = cKDTree(fracture.points).query(x[self.cover])[1]
             self.band_width = float(volume[self.cover].sum() / fracture.weights.sum())
         self.slip = np.zeros(fracture.num_points)
@@ -270,6 +274,14 @@ class FractureContact:
         k0 = np.where(is_open, mobility, CLOSED_PERMEABILITY * mobility)
         k_fc = np.where(is_open, crack_flow.fracture_permeability(w, np.full(len(w), self.band_width), viscosity), 0.0)
         return self.cover, crack_flow.permeability_tensor(k0, k_fc, self.interface.normal[self.nearest])
+
+    def added_permeability(self, k: np.ndarray, mobility: float, viscosity: float) -> np.ndarray:
+        """The permeabilities ``k`` (per carrier point, shape ``(n, 2, 2)``) with the fracture's:
+        at the carriers the host's isotropic k_f0 gives way to the fracture's tensor, their own
+        crack bands' enhancement kept. Modifies and returns ``k``."""
+        cover, k_fracture = self.permeability(mobility, viscosity)
+        k[cover] += k_fracture - mobility * np.eye(2)
+        return k
 
     def aperture(self) -> np.ndarray:
         """g_N at the last ``forces`` [m]."""

@@ -8,7 +8,9 @@ protocol (``rkfx.solvers.model``): the RKPM hydraulic-fracture model and its cra
 baseline share it. The model holds ``committed`` (a ``DamageState``), ``points`` (its
 ``DamageModel``), ``allowed`` (or ``None`` without tracking), ``parent``, ``iterations`` (Newton
 iterations of every accepted step), ``_count`` (those of the step under way) and ``track`` (a
-``rkfx.fracture.tracking.Tracking``, or ``None``).
+``rkfx.fracture.tracking.Tracking``, or ``None``). A model with a pre-existing fracture sets
+``fracture`` (a ``rkfx.fracture.contact.FractureContact``, whose slip is history too): it is
+committed, saved and restored with the damage.
 
 Damage updates (``damage_update``, set by the model):
 
@@ -42,6 +44,7 @@ class DamageHistory:
 
     MAX_TRACKING_ROUNDS = 1000  # admissions within one residual (each admits at least one point)
     damage_update = "implicit"
+    fracture = None  # a FractureContact with its own trial/commit history, or None
     _dt = None                 # the step under way (start_step)
     _kappa_before = None       # impl-ex: kappa of the committed step before the last, and
     _dt_before = None          # the last committed step's size
@@ -134,6 +137,8 @@ class DamageHistory:
         dm.check_regularization(self.points, self.committed)
         self.iterations.append(self._count)
         self._count = 0
+        if self.fracture is not None:
+            self.fracture.commit()
 
     def state(self) -> dict[str, np.ndarray]:
         """The committed damage state, the admissions and the Newton iterations, for checkpoints."""
@@ -144,6 +149,8 @@ class DamageHistory:
         if self.damage_update == "impl-ex" and self._kappa_before is not None:
             out["implex_kappa_before"] = self._kappa_before
             out["implex_dt_before"] = np.array([self._dt_before])
+        if self.fracture is not None:
+            out |= self.fracture.state()
         return out
 
     def restore(self, arrays) -> None:
@@ -158,4 +165,6 @@ class DamageHistory:
         if "implex_kappa_before" in arrays:
             self._kappa_before = np.array(arrays["implex_kappa_before"])
             self._dt_before = float(np.asarray(arrays["implex_dt_before"])[0])
+        if self.fracture is not None:
+            self.fracture.restore(arrays)
         self._extrapolated = self._last_strain = None

@@ -289,8 +289,7 @@ class HydraulicFractureModel(DamageHistory):
         k = crack_permeability(self.rock.mobility, state.damage, CrackBands(_unit(state.normal),
                                self.band_widths(state)), strain, self.rock.viscosity)
         if self.fracture is not None:
-            cover, k_fracture = self.fracture.permeability(self.rock.mobility, self.rock.viscosity)
-            k[cover] += k_fracture - self.rock.mobility * np.eye(2)
+            self.fracture.added_permeability(k, self.rock.mobility, self.rock.viscosity)
         return k
 
     def pressures(self, x: np.ndarray) -> np.ndarray:
@@ -435,19 +434,6 @@ class HydraulicFractureModel(DamageHistory):
         """-beta_2 dt / beta_1 = -1 / (du'/du) on the storage rows, as in (5.24)."""
         n = self.n
         return np.r_[np.ones(2 * n), np.full(n, -1.0 / co.dv[0])]
-
-    def commit(self) -> None:
-        super().commit()
-        if self.fracture is not None:
-            self.fracture.commit()
-
-    def state(self) -> dict[str, np.ndarray]:
-        return super().state() | ({} if self.fracture is None else self.fracture.state())
-
-    def restore(self, arrays) -> None:
-        super().restore(arrays)
-        if self.fracture is not None:
-            self.fracture.restore(arrays)
 
     def _damage(self, eps: np.ndarray) -> dm.DamageUpdate:
         """The damage of ``eps``: the trial with the tracking admissions, or the step's impl-ex
