@@ -246,7 +246,7 @@ class Block:
         self.rk = rk_approximation(self.p.x, self.p.spacing, support_factor, cracks=cracks)
         self.domains = nodal_cells(self.p)
         x = self.p.x
-        self._notch_end = notch
+        self.notch_half_length = notch
         self.notch_mask = self.in_notch(x)
         self.notch = np.flatnonzero(self.notch_mask)
         a, b = self.segment
@@ -273,7 +273,7 @@ class Block:
     def in_notch(self, x: np.ndarray) -> np.ndarray:
         """Points of ``x`` on the notch's mesh line (y = 0, |x| <= notch)."""
         on = 1e-9 * self.side
-        return (np.abs(x[:, 1]) < on) & (np.abs(x[:, 0]) <= self._notch_end + on)
+        return (np.abs(x[:, 1]) < on) & (np.abs(x[:, 0]) <= self.notch_half_length + on)
 
 
 @dataclass(frozen=True)
@@ -432,7 +432,7 @@ class _Fem(_Method):
 
         side = geo.edge
         sx, sy = conditions["confinement"]
-        notch, h = geo._notch_end, geo.h
+        notch, h = geo.notch_half_length, geo.h
         # The notch as a band of elements: those with their three vertices within 1.25 h of the
         # notch line (the elements on its edges; the next row of vertices lies ~1.7 h off it).
         band = Region(lambda x: (np.abs(x[:, 1]) <= 1.25 * h) & (np.abs(x[:, 0]) <= notch + 0.5 * h), "notch band")
