@@ -390,6 +390,7 @@ class FemHydraulicFractureModel(DamageHistory):
         self._natural = NaturalLoads(mesh, self.boundary, self.V, self.Q, kinds[Traction], kinds[Flux]) \
             if kinds[Traction] or kinds[Flux] else None
         self._loads_at: tuple[float, np.ndarray] | None = None
+        self._no_loads = np.zeros(self.n_dofs)
         if contact is not None:
             self.fracture = FractureContact(nodal_interface(fracture, self.u_nodes, self.p_nodes), contact,
                                             self.centroids, self.area, carriers=touching(fracture, self.vertices))
@@ -568,15 +569,10 @@ class FemHydraulicFractureModel(DamageHistory):
     def loads(self, t: float) -> np.ndarray:
         """[F(t), Q(t)] of the tractions and fluxes (zero without them), shape ``(n_dofs,)``."""
         if self._natural is None:
-            return np.zeros(self.n_dofs)
+            return self._no_loads
         if self._loads_at is None or (self._loads_at[0] != t and self._natural.varies):
             self._loads_at = (t, self._natural.assemble(t, self.n_u, self.n_dofs))
         return self._loads_at[1]
-
-    def opening(self, state: dm.DamageState | None = None) -> np.ndarray:
-        """w / w_c = D kappa / kappa_c of every element (``rkfx.fracture.damage.crack_opening``), shape ``(m,)``."""
-        st = self.committed if state is None else state
-        return dm.crack_opening(st.kappa, self.points.kappa0, st.kappa_c)
 
     # ------------------------------------------------------------------ model protocol
 

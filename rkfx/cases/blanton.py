@@ -123,7 +123,6 @@ from rkfx.cases import _cli, _preflight
 from rkfx.cases._cli import Param, Results, Run
 from rkfx.conditions import Displacement, Pressure, Region, Traction
 from rkfx.errors import InputError, SolverError
-from rkfx.fracture import damage as dm
 from rkfx.fracture.contact import OPEN, SLIP, STICK, FrictionalContact
 from rkfx.fracture.history import DAMAGE_UPDATES
 from rkfx.fracture.tracking import check_tracking, tracking
@@ -338,7 +337,7 @@ class _Record:
         m = self.model
         st = m.committed
         self.series.write(s.t, displacement=m.displacements(s.x), pressure=m.pressures(s.x), damage=st.damage,
-                          crack_opening=dm.crack_opening(st.kappa, m.points.kappa0, st.kappa_c),
+                          crack_opening=m.opening(),
                           strain=m.strain * [1.0, 1.0, 0.5])
 
     def arrays(self):
@@ -382,7 +381,7 @@ class _Method:
 
     def cracked(self) -> np.ndarray:
         """Which sites are cracked (the notch's excluded), shape ``(len(sites.x),)`` bool."""
-        raise NotImplementedError
+        return (self.model.opening() >= CRACKED) & ~self.notch
 
     def borehole_pressure(self, x: np.ndarray) -> float:
         """The largest pressure along the notch for the unknowns ``x`` [Pa]."""
@@ -405,16 +404,11 @@ class _Rkpm(_Method):
         self.sites, self.notch, self.geo = geo, geo.notch_mask, geo
         self.n_dofs = 3 * geo.p.num_nodes
 
-    def cracked(self) -> np.ndarray:
-        st = self.model.committed
-        return (dm.crack_opening(st.kappa, self.model.points.kappa0, st.kappa_c) >= CRACKED) & ~self.notch
-
     def borehole_pressure(self, x: np.ndarray) -> float:
         return float(self.model.pressures(x)[self.geo.notch].max())
 
     def fields(self, x: np.ndarray) -> dict:
-        st = self.model.committed
-        return {"opening": dm.crack_opening(st.kappa, self.model.points.kappa0, st.kappa_c),
+        return {"opening": self.model.opening(),
                 "p": self.model.pressures(x)}
 
 
@@ -448,9 +442,6 @@ class _Fem(_Method):
         self.sites, self.notch = geo.sites(m.centroids), m.precracked
         self._borehole = m.n_u + np.flatnonzero(geo.in_notch(m.p_nodes))
         self.n_dofs = m.n_dofs
-
-    def cracked(self) -> np.ndarray:
-        return (self.model.opening() >= CRACKED) & ~self.notch
 
     def borehole_pressure(self, x: np.ndarray) -> float:
         return float(x[self._borehole].max())

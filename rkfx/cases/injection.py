@@ -104,7 +104,6 @@ from rkfx.cases._cli import Param, Results, Run
 from rkfx.report.claims import Claim
 from rkfx.conditions import Displacement, Pressure, Region
 from rkfx.errors import InputError, SolverError
-from rkfx.fracture import damage as dm
 from rkfx.fracture.tracking import check_tracking, tracking
 from rkfx.fracture.history import DAMAGE_UPDATES
 from rkfx.geometry.grid_cells import grid_domains
@@ -252,8 +251,7 @@ class _Record:
         self._seen = 0  # substeps of the model already counted
 
     def opening(self) -> np.ndarray:
-        st, pts = self.model.committed, self.model.points
-        return dm.crack_opening(st.kappa, pts.kappa0, st.kappa_c)
+        return self.model.opening()
 
     def record(self, s) -> None:
         m = self.model

@@ -115,6 +115,12 @@ class DamageHistory:
             upd = dm.update(self.points, self.committed, eps, allowed=allowed, **options)
         return upd
 
+    def opening(self, state: dm.DamageState | None = None) -> np.ndarray:
+        """w / w_c = D kappa / kappa_c of every point (``rkfx.fracture.damage.crack_opening``) of
+        ``state`` (default the committed one), shape ``(m,)``."""
+        st = self.committed if state is None else state
+        return dm.crack_opening(st.kappa, self.points.kappa0, st.kappa_c)
+
     def _admit(self, new: np.ndarray, normal: np.ndarray, allowed: np.ndarray, parent: np.ndarray) -> bool:
         """Allow, in place, the tracking candidates (4.22) of the points ``new`` that initiated
         with ``normal``; whether any was not allowed before."""
