@@ -19,7 +19,8 @@ element e:
   for Taylor-Hood P2 elements the damage is that of the element's mean strain
   (1/A_e) int_e eps dx, and the stress (1 - D_e) C eps(x) varies inside the element.
 * effective stress (5.3)-(5.5): (1 - D) C eps with 1 - D kept at or above ``residual``
-  (1e-6, the RKPM model's low residual strength);
+  (1e-6, the RKPM model's low residual strength); with ``closure`` a closed crack carries
+  compression across it (``rkfx.fracture.closure``, on the element's mean strain);
 * Biot coefficient and storage: ``FracturingRock.biot`` (alpha = 1 - (1 - D) K / K_s or the
   rock's constant) and ``FracturingRock.storage`` (1/Q, 5.29);
 * permeability (5.8) from ``rkfx.materials.crack_flow`` through
@@ -178,6 +179,7 @@ from fem_baselines.poroelasticity import (NaturalLoads, _gather, _global_matrix,
 from rkfx.conditions import Condition, Displacement, Flux, Pressure, Region, Traction, values
 from rkfx.errors import InputError, SolverError
 from rkfx.fracture import damage as dm
+from rkfx.fracture.closure import CrackClosure, direction
 from rkfx.fracture.contact import FractureContact, FrictionalContact
 from rkfx.fracture.history import DamageHistory
 from rkfx.fracture.tracking import tracking
@@ -293,6 +295,8 @@ class FemHydraulicFractureModel(DamageHistory):
             (``fem_baselines.fracture_faces``); the elements with a vertex on its faces carry its
             flow (open: (5.8) with w = g_N; closed: k_f0 / 100), as the RKPM model's particles
             covering it do. ``None``: no such fracture.
+        closure: A closed crack carries compression across it (``rkfx.fracture.closure``, on the
+            element's mean strain), as the RKPM model's ``closure``.
 
     Attributes:
         committed: The committed ``rkfx.fracture.damage.DamageState`` of the elements (element
@@ -315,7 +319,8 @@ class FemHydraulicFractureModel(DamageHistory):
                  residual: float = RESIDUAL_STIFFNESS, track: tuple[float, float] | None = None,
                  damage_update: str = "implicit",
                  injection: tuple[Region, Callable[[float], float]] | None = None,
-                 contact: FrictionalContact | None = None, fracture: FractureFaces | None = None):
+                 contact: FrictionalContact | None = None, fracture: FractureFaces | None = None,
+                 closure: bool = False):
         if not isinstance(rock, FracturingRock):
             raise InputError(f"rock = {rock!r}: give a rkfx.models.hydraulic_fracture.FracturingRock")
         if element not in ELEMENTS:
@@ -344,6 +349,7 @@ class FemHydraulicFractureModel(DamageHistory):
         self.comm, self.rock, self.element, self.mass_kind = mesh.comm, rock, element, mass
         self.jacobian = "full" if jacobian == "full" else "symmetrized"
         self.residual_fraction = float(residual)
+        self.closure = CrackClosure.for_material(rock.damage_material.elasticity()) if closure else None
         self.mesh = mesh
         tdim = mesh.topology.dim
         mesh.topology.create_connectivity(tdim - 1, tdim)
@@ -591,6 +597,9 @@ class FemHydraulicFractureModel(DamageHistory):
             self._kc = self._kc_constant
         self._x = x
         f_u = self._ku @ u - self._kc @ P
+        if self.closure is not None:  # int_e sigma_c : eps(v) with the element's mean strain
+            s_c = self.closure.stress(eps, _unit(st.normal), self._damaged_fraction(st))
+            f_u = f_u + sum(b.T @ (self.area * s_c[:, k]) for k, b in enumerate(self._B))
         if self.fracture is not None:
             f_u = f_u + self.fracture.forces(u, P)  # before the permeability: it reads the apertures
         k = self.permeability(st, eps)
@@ -627,11 +636,28 @@ class FemHydraulicFractureModel(DamageHistory):
             self.assign(self._x)
             force = _global_matrix(self._a_force, self.comm).tocsc()[:, on]
             k_u = (k_u - force @ self._rows(dd, on)).tocsr()
+        if self.closure is not None:
+            k_u = k_u + self._closure_stiffness()
         k_up = -self._kc
         if self.fracture is not None:
             k_u, k_up = k_u + self.fracture.stiffness(), k_up + self.fracture.pressure_coupling()
         k_pu = self._flow_derivative(on, dd) if self.jacobian == "full" else None
         return sp.bmat([[k_u, k_up], [k_pu, self._kh]], format="csr")
+
+    def _damaged_fraction(self, state: dm.DamageState) -> np.ndarray:
+        """The stiffness fraction the damage removed, 1 - max(1 - D, residual), per element."""
+        return 1.0 - np.maximum(1.0 - state.damage, self.residual_fraction)
+
+    def _closure_stiffness(self) -> sp.csr_matrix:
+        """sum_e A_e D M H(-eps_nn) (v . eps_e(du)) (v . eps_e(dv)) at the last residual."""
+        st = self.trial.state
+        normal = _unit(st.normal)
+        c = self.closure.normal_stiffness(self.strain, normal, self._damaged_fraction(st))
+        on = np.flatnonzero(c)
+        if on.size == 0:
+            return sp.csr_matrix((self.n_u, self.n_u))
+        rows = self._rows(direction(normal[on]), on)
+        return (rows.T @ sp.diags(self.area[on] * c[on]) @ rows).tocsr()
 
     def _flow_derivative(self, loading: np.ndarray, dd: np.ndarray) -> sp.csr_matrix | None:
         """d(K_H P)/dU (5.33) at the last residual, shape ``(n_p, n_u)``, or ``None`` where no

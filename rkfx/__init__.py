@@ -39,6 +39,7 @@ data path (see docs/core.md):
         tracking         candidate damage particles along crack segments (eq. 4.22)
         history          trial and committed damage of implicit models, with tracking admissions
         contact          pre-existing fractures: penalty frictional contact (5.38)-(5.39), their flow
+        closure          crack closure: a closed smeared crack carries compression across it
     models          what the steppers advance
         elastostatics    elastostatics in 2-D and 3-D
         poroelasticity   equal-order u-p Biot model: NI/SCNI with pressure projection (chapter 3),

@@ -97,7 +97,7 @@ particles (element centroids) at the end
 Parameters (``--set NAME=VALUE``, SI units, angles in degrees): E, nu, rho_s, rho_w, porosity,
 k_h, gamma_w, K_w, K_s, GF, ft, viscosity, side, offset, notch, tests, h, mu, penalty,
 t_confine, t_drain, t_ramp, dt, t_grow, margin, tol, radius, jacobian, damage_update,
-support_factor, max_cuts. Long runs: ``--checkpoint-every N`` and ``--resume DIR`` (one folder
+support_factor, max_cuts, closure. Long runs: ``--checkpoint-every N`` and ``--resume DIR`` (one folder
 per test and spacing).
 
     python -m rkfx.cases.blanton [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR] [--vtk]
@@ -182,6 +182,8 @@ PARAMS = {
     "damage_update": Param("impl-ex", "impl-ex (extrapolated over a step) or implicit (every Newton iterate)"),
     "support_factor": Param(1.5, "RK support radius / spacing [-]"),
     "max_cuts": Param(8, "halvings of a step whose Newton fails before the run stops [-]"),
+    "closure": Param(False, "a closed crack carries compression across it (rkfx.fracture.closure); "
+                            "false: the seed's isotropic damage"),
 }
 QUICK = {"h": [5e-3]}
 ROCK_FIELDS = ("E", "nu", "rho_s", "rho_w", "porosity", "k_h", "gamma_w", "K_w", "K_s", "GF", "ft", "viscosity")
@@ -192,7 +194,8 @@ def _rock(**m) -> FracturingRock:
 
 
 def check(*, side, offset, notch, tests, h, mu, penalty, t_confine, t_drain, t_ramp, dt, t_grow, margin, tol,
-          radius, jacobian, damage_update, support_factor, max_cuts, methods=("rkpm",), **material) -> None:
+          radius, jacobian, damage_update, support_factor, max_cuts, methods=("rkpm",), closure=False,
+          **material) -> None:
     """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
     _rock(**material)
     _preflight.known(tests, TESTS, "test")
@@ -394,13 +397,13 @@ class _Method:
 
 class _Rkpm(_Method):
     def __init__(self, geo: Block, rock, conditions: dict, contact: FrictionalContact, track, jacobian,
-                 damage_update, comm):
+                 damage_update, comm, closure=False):
         self.model = HydraulicFractureModel(
             geo.p, geo.rk, geo.domains, rock, displacements=PLATENS,
             pressures=[conditions["borehole"]] + [Pressure(e) for e in ("bottom", "right", "top", "left")],
             tractions=_tractions(*conditions["confinement"]), precracked=geo.notch, precrack_normal=(0.0, 1.0),
             jacobian=jacobian, track=tracking(geo.p.x, geo.p.spacing, track[0], seeds=geo.notch, radius=track[1]),
-            contact=contact, fracture="fracture", damage_update=damage_update)
+            contact=contact, fracture="fracture", damage_update=damage_update, closure=closure)
         self.sites, self.notch, self.geo = geo, geo.notch_mask, geo
         self.n_dofs = 3 * geo.p.num_nodes
 
@@ -419,7 +422,7 @@ class _Fem(_Method):
     (``fem_baselines.fracture_faces``)."""
 
     def __init__(self, geo: Block, rock, conditions: dict, contact: FrictionalContact, track, jacobian,
-                 damage_update, comm):
+                 damage_update, comm, closure=False):
         from fem_baselines.fracture_faces import fracture_faces  # noqa: PLC0415  (dolfinx only where FEM runs)
         from fem_baselines.hydraulic_fracture import FemHydraulicFractureModel  # noqa: PLC0415
         from fem_baselines.poroelasticity import triangle_mesh  # noqa: PLC0415
@@ -437,7 +440,7 @@ class _Fem(_Method):
             + _tractions(sx, sy, side("right"), side("top")),
             precracked=band, precrack_normal=(0.0, 1.0), element="p1p1-fpp", mass="lumped", jacobian=jacobian,
             track=track, damage_update=damage_update, contact=contact,
-            fracture=fracture_faces(geo.p, "fracture", geo.segment))
+            fracture=fracture_faces(geo.p, "fracture", geo.segment), closure=closure)
         m = self.model
         self.sites, self.notch = geo.sites(m.centroids), m.precracked
         self._borehole = m.n_u + np.flatnonzero(geo.in_notch(m.p_nodes))
@@ -455,7 +458,7 @@ METHOD_MODELS = {"rkpm": _Rkpm, "fem": _Fem}
 
 def solve_test(name: str, h: float, method: str = "rkpm", *, rock, side, offset, notch, mu, penalty, t_confine,
                t_drain, t_ramp, dt, t_grow, margin, tol, radius, jacobian, damage_update, support_factor, max_cuts,
-               ck=None, comm=None, vtk=None) -> dict:
+               closure=False, ck=None, comm=None, vtk=None) -> dict:
     """One test of Table 5.1 at spacing ``h`` by ``method`` (``rkpm`` or ``fem``; module
     docstring); with ``vtk`` a folder, the RKPM particle fields at the pressurization, every
     VTK_EVERY growth steps and at the end."""
@@ -470,7 +473,7 @@ def solve_test(name: str, h: float, method: str = "rkpm", *, rock, side, offset,
                   "confinement": (sx, sy)}
     solver = METHOD_MODELS[method](geo, rock, conditions,
                                    FrictionalContact(k_N=penalty * rock.E / h, k_T=penalty * rock.E / h, mu=mu),
-                                   (tol, radius), jacobian, damage_update, comm)
+                                   (tol, radius), jacobian, damage_update, comm, closure)
     model, sites = solver.model, solver.sites
     times = _step_times(t_confine, t_press, t_ramp, dt, t_grow)
     series = None
@@ -535,14 +538,15 @@ def run(*, methods: Sequence[str] = ("rkpm",), E=1e10, nu=0.22, rho_s=1900.0, rh
         gamma_w=1e4, K_w=2.2e9, K_s=1e11, GF=35.0, ft=5e6, viscosity=1e-3, side=0.305, offset=0.05, notch=0.04,
         tests=tuple(TESTS), h=(5e-3, 3.5e-3), mu=0.7, penalty=1.0, t_confine=100.0, t_drain=100.0, t_ramp=0.01,
         dt=5e-4, t_grow=0.2, margin=0.015, tol=0.3, radius=3.5, jacobian="symmetric", damage_update="impl-ex",
-        support_factor=1.5, max_cuts=8, checkpoint_every=0, work_dir=None, resume=None, vtk=None) -> Results:
+        support_factor=1.5, max_cuts=8, closure=False, checkpoint_every=0, work_dir=None, resume=None, vtk=None) -> Results:
     """Every test at every spacing; see the module docstring. ``vtk``: a folder for the ParaView
     files (``--vtk``)."""
     material = dict(E=E, nu=nu, rho_s=rho_s, rho_w=rho_w, porosity=porosity, k_h=k_h, gamma_w=gamma_w, K_w=K_w,
                     K_s=K_s, GF=GF, ft=ft, viscosity=viscosity)
     setup = dict(side=side, offset=offset, notch=notch, mu=mu, penalty=penalty, t_confine=t_confine,
                  t_drain=t_drain, t_ramp=t_ramp, dt=dt, t_grow=t_grow, margin=margin, tol=tol, radius=radius,
-                 jacobian=jacobian, damage_update=damage_update, support_factor=support_factor, max_cuts=max_cuts)
+                 jacobian=jacobian, damage_update=damage_update, support_factor=support_factor, max_cuts=max_cuts,
+                 closure=closure)
     check(tests=list(tests), h=list(h), methods=tuple(methods), **setup, **material)
     rock = _rock(**material)
     predictions = {p.test.name: p for p in blanton_modes(mu=mu, T0=ft)}

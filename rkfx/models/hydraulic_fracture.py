@@ -36,6 +36,11 @@ carry the fluid pressure and the penalty frictional contact (5.38)-(5.39)
 the fracture slips) and the u-p block the pressure on the faces. The particles covering it
 take its permeability (open: (5.8) with w = g_N; closed: k_f0 / 100) plus their own crack
 band's enhancement; that permeability is not differentiated in the Jacobian.
+
+With ``closure`` a closed crack carries compression across it (``rkfx.fracture.closure``): the
+stress and tangent of a damaged particle whose n . eps . n < 0 gain D M (n . eps . n) v and
+D M v (x) v; the seed's isotropic damage (off, the default) lets a band squeezed across its
+crack give way.
 """
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
@@ -50,6 +55,7 @@ from rkfx.assembly.smeared_strain import lumped_mass, row_strains
 from rkfx.conditions import Displacement, Flux, Pressure, Region, Traction
 from rkfx.errors import InputError
 from rkfx.fracture import damage as dm
+from rkfx.fracture.closure import CrackClosure
 from rkfx.fracture.contact import FractureContact, FrictionalContact, interface
 from rkfx.fracture.history import DamageHistory
 from rkfx.fracture.tracking import Tracking
@@ -194,6 +200,8 @@ class HydraulicFractureModel(DamageHistory):
         damage_update: ``"implicit"`` (the seed's: the damage of every Newton iterate) or
             ``"impl-ex"`` (the damage of a step extrapolated from the two before it, the
             implicit update committed at its end; ``rkfx.fracture.history``).
+        closure: A closed crack carries compression across it (``rkfx.fracture.closure``, with
+            M = lambda + 2 mu); ``False``: the seed's isotropic damage in compression too.
         track: Particle tracking (``rkfx.fracture.tracking``): only its seeds, the damaged
             particles and the candidates (4.22) of the damaged ones may damage. Within every
             residual the particles that initiate admit their candidates at once and the
@@ -216,7 +224,7 @@ class HydraulicFractureModel(DamageHistory):
                  jacobian: str = "symmetric", track: Tracking | None = None,
                  injection: tuple[Region, Callable[[float], float]] | None = None,
                  contact: FrictionalContact | None = None, fracture: str = "crack",
-                 damage_update: str = "implicit"):
+                 damage_update: str = "implicit", closure: bool = False):
         if jacobian not in JACOBIANS:
             raise InputError(f"jacobian = {jacobian!r}; choose one of {', '.join(JACOBIANS)}")
         self.jacobian = jacobian
@@ -241,6 +249,7 @@ class HydraulicFractureModel(DamageHistory):
         self.fracture = None if contact is None else FractureContact(interface(p, rk=rk, domains=domains, name=fracture),
                                                                      contact, p.x, self.volume)
         self._C = rock.damage_material.elasticity()
+        self.closure = CrackClosure.for_material(self._C) if closure else None
         cells = domains if domains.subcell_vertices is not None else p  # grid cells, or median-dual cells of p
         self.points = dm.damage_model(rock.damage_material, self.volume, geometry=dm.cell_geometry(cells))
         self.committed = initial_damage(self.points, np.zeros(0, np.int64) if precracked is None else precracked,
@@ -336,6 +345,8 @@ class HydraulicFractureModel(DamageHistory):
         st = upd.state
         frac = self._stiffness_fraction(st.damage)
         stress = frac[:, None] * (eps @ self._C.T)
+        if self.closure is not None:
+            stress += self.closure.stress(eps, _unit(st.normal), 1.0 - frac)
         it = self.integration
         f_int = self._bt @ (self.volume[:, None] * stress).ravel() + self._stabilization() @ u
         alpha = self.rock.biot(st.damage)
@@ -352,7 +363,12 @@ class HydraulicFractureModel(DamageHistory):
         """The symmetrized Jacobian's blocks (5.36): [[K_U, -K_C], [0, K_H]] at the last residual."""
         self._count += 1
         # (5.35) with 1 - D floored at the residual fraction, as in the stress.
-        k_u = stiffness([self.nodal], [self.trial.tangent]) + self._stabilization()
+        tangent = self.trial.tangent
+        if self.closure is not None:
+            st = self.trial.state
+            tangent = tangent + self.closure.tangent(self.strain, _unit(st.normal),
+                                                     1.0 - self._stiffness_fraction(st.damage))
+        k_u = stiffness([self.nodal], [tangent]) + self._stabilization()
         k_up = -self._coupling
         if self.fracture is not None:
             k_u, k_up = k_u + self.fracture.stiffness(), k_up + self.fracture.pressure_coupling()
