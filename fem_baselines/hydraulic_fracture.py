@@ -858,7 +858,7 @@ def solve_hydraulic_fracture(h: float, rock: FracturingRock, rate: float = 5.5e4
                              element: str = "p1p1-fpp", mass: str = "lumped", jacobian: str = "full",
                              residual: float = RESIDUAL_STIFFNESS, track: tuple[float, float] | None = None,
                              damage_update: str = "implicit", injection_rate: float = 0.0,
-                             output_times: Sequence[float] = (),
+                             closure: bool = False, output_times: Sequence[float] = (),
                              sample_points: np.ndarray | None = None, line_search: bool = True,
                              max_cuts: int = 12, comm: MPI.Comm | None = None, checkpoint_every: int = 0,
                              checkpoint_dir: str | Path | None = None, resume: str | Path | None = None,
@@ -880,8 +880,9 @@ def solve_hydraulic_fracture(h: float, rock: FracturingRock, rate: float = 5.5e4
         L, c: Plate side and notch half-length [m].
         notch_width: Half-width of the pressurized vertices about the notch line [spacings]
             (the RKPM case's 1.5 support radii).
-        element, mass, jacobian, residual, track, damage_update: As ``FemHydraulicFractureModel`` (``track``:
-            ``None``, the default, lets every element damage; ``(0.3, 3.5)`` is the RKPM case's).
+        element, mass, jacobian, residual, track, damage_update, closure: As
+            ``FemHydraulicFractureModel`` (``track``: ``None``, the default, lets every element damage;
+            ``(0.3, 3.5)`` is the RKPM case's).
         injection_rate: > 0: fluid injected into the notch's elements at Q = injection_rate t
             [m^2/s per metre of thickness] in place of the notch pressure (``rate`` then unused).
         output_times: Step times at which p, D and w / w_c are kept.
@@ -934,7 +935,7 @@ def solve_hydraulic_fracture(h: float, rock: FracturingRock, rate: float = 5.5e4
         conditions.append(Pressure(notch, lambda x, t: np.full(len(x), rate * t)))
     model = FemHydraulicFractureModel(mesh, rock, conditions, precracked=notch, element=element, mass=mass,
                                       jacobian=jacobian, residual=residual, track=track,
-                                      damage_update=damage_update, injection=injection)
+                                      damage_update=damage_update, injection=injection, closure=closure)
     if sample_points is None:
         g = np.linspace(-L / 2, L / 2, 21)
         sample_points = np.column_stack([np.repeat(g, 21), np.tile(g, 21)])

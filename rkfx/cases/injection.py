@@ -80,7 +80,7 @@ always have (at h = 0.025 m both starts take the same 93 iterations).
 
 Parameters (``--set NAME=VALUE``, SI units): E, nu, rho_s, rho_w, porosity, k_h, gamma_w, K_w,
 K_s, GF, ft, viscosity, alpha, L, c, rate, t_end, dt, t_out, h, fem_h, tol, radius, jacobian,
-damage_update, support_factor, max_cuts, residual, injection_rate. Long runs: ``--checkpoint-every N`` and ``--resume DIR``.
+damage_update, support_factor, max_cuts, residual, injection_rate, closure. Long runs: ``--checkpoint-every N`` and ``--resume DIR``.
 
     python -m rkfx.cases.injection [--quick] [--method rkpm|both] [--set NAME=VALUE] [--out DIR] [--vtk]
 
@@ -158,6 +158,8 @@ PARAMS = {
     "injection_rate": Param(0.0, "rate-driven loading: fluid injected into the notch's particles at Q = "
                                  "injection_rate t [m^2/s^2, per metre of thickness] in place of the notch "
                                  "pressure; 0: the seed's p_bar = rate t (see the docstring)"),
+    "closure": Param(False, "a closed crack carries compression across it (rkfx.fracture.closure); "
+                            "false: the seed's isotropic damage"),
 }
 QUICK = {"h": [0.05, 0.025], "fem_h": [0.05, 0.025], "dt": 100.0, "t_end": 2000.0, "t_out": [1000.0, 2000.0]}
 
@@ -168,7 +170,7 @@ def _intervals(length: float, h: float) -> int:
 
 def check(*, L, c, h, dt, t_end, t_out, tol, radius, jacobian, support_factor, rate, max_cuts=12,
           damage_update="implicit", residual=1e-6, injection_rate=0.0, methods=("rkpm",), fem_h=(),
-          **material) -> None:
+          closure=False, **material) -> None:
     """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
     spacings = [("h", hh) for hh in h] + ([("fem_h", hh) for hh in fem_h] if "fem" in methods else [])
     _rock(**{k: material[k] for k in ("E", "nu", "rho_s", "rho_w", "porosity", "k_h", "gamma_w", "K_w", "K_s",
@@ -297,7 +299,8 @@ class _Record:
 
 
 def solve(h: float, *, L, c, rate, t_end, dt, t_out, tol, radius, jacobian, support_factor, rock, max_cuts=12,
-          damage_update="implicit", residual=1e-6, injection_rate=0.0, io=None, comm=None, vtk=None) -> dict:
+          damage_update="implicit", residual=1e-6, injection_rate=0.0, closure=False, io=None, comm=None,
+          vtk=None) -> dict:
     """One refinement: the crack history, maps and Darcy velocity (see the module docstring); with
     ``vtk`` a folder, the particle fields at the times ``t_out`` are written there."""
     t0 = time.perf_counter()
@@ -319,7 +322,7 @@ def solve(h: float, *, L, c, rate, t_end, dt, t_out, tol, radius, jacobian, supp
         p, rk, domains, rock, displacements=[Displacement(s) for s in SIDES],
         pressures=([] if by_rate else [Pressure(region, lambda x, t: np.full(len(x), rate * t))])
         + [Pressure(s) for s in SIDES], precracked=np.flatnonzero(notch), jacobian=jacobian,
-        damage_update=damage_update, residual=residual,
+        damage_update=damage_update, residual=residual, closure=closure,
         track=tracking(p.x, p.spacing, tol, seeds=notch, radius=radius),
         injection=(region, lambda t: injection_rate * t) if by_rate else None)
     samples = _sample_grid(L)
@@ -363,7 +366,7 @@ def run(*, methods: Sequence[str] = ("rkpm",), E=2.1e11, nu=0.3, rho_s=3000.0, r
         rate=5.5e4, t_end=4000.0, dt=50.0, t_out=(1000.0, 2000.0, 3000.0, 4000.0), h=(5e-3, 2.5e-3),
         fem_h=(5e-3, 2.5e-3), tol=0.3,
         radius=3.5, jacobian="full", damage_update="implicit", support_factor=1.5, max_cuts=12, residual=1e-6,
-        injection_rate=0.0, checkpoint_every=0,
+        injection_rate=0.0, closure=False, checkpoint_every=0,
         work_dir=None, resume=None,
         vtk=None) -> Results:
     """Every refinement; see the module docstring. ``vtk``: a folder for the ParaView files (``--vtk``)."""
@@ -371,7 +374,7 @@ def run(*, methods: Sequence[str] = ("rkpm",), E=2.1e11, nu=0.3, rho_s=3000.0, r
                     K_s=K_s, GF=GF, ft=ft, viscosity=viscosity, alpha=alpha)
     setup = dict(L=L, c=c, rate=rate, t_end=t_end, dt=dt, t_out=list(t_out), tol=tol, radius=radius,
                  jacobian=jacobian, damage_update=damage_update, support_factor=support_factor, max_cuts=max_cuts,
-                 residual=residual, injection_rate=injection_rate)
+                 residual=residual, injection_rate=injection_rate, closure=closure)
     check(h=list(h), methods=tuple(methods), fem_h=list(fem_h), **setup, **material)
     rock = _rock(**material)
     est = onset_estimates(rock, c, rate)
@@ -477,7 +480,7 @@ def _compare_refinements(runs: list[Run]) -> None:
 
 
 def solve_fem(h: float, *, L, c, rate, t_end, dt, t_out, jacobian, rock, max_cuts=12, damage_update="implicit",
-              residual=1e-6, injection_rate=0.0, io=None, comm=None, **_) -> Run:
+              residual=1e-6, injection_rate=0.0, closure=False, io=None, comm=None, **_) -> Run:
     """One crack-band FEM refinement (``fem_baselines.hydraulic_fracture``) on the particles of
     spacing ``h`` as mesh vertices, reported as the RKPM runs are."""
     import dolfinx_solver  # noqa: F401, PLC0415
@@ -488,7 +491,8 @@ def solve_fem(h: float, *, L, c, rate, t_end, dt, t_out, jacobian, rock, max_cut
     times = _step_times(t_end, dt, t_out)
     samples = _sample_grid(L)
     res = solve_hydraulic_fracture(h, rock, rate, times, L=L, c=c, jacobian=jacobian, damage_update=damage_update,
-                                   residual=residual, injection_rate=injection_rate, output_times=t_out,
+                                   residual=residual, injection_rate=injection_rate, closure=closure,
+                                   output_times=t_out,
                                    sample_points=samples, max_cuts=max_cuts, comm=comm,
                                    progress=lambda it: _cli.progress(it, label, len(times) - 1), **(io or {}))
     if res.stopped is not None and (comm is None or comm.rank == 0):
