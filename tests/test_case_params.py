@@ -70,6 +70,20 @@ def test_a_resume_reads_runs_stored_under_an_alias(tmp_path):
         _cli.check_resume(tmp_path, {**stamp, "params": {**stamp["params"], "h": [1e-3]}}, False, kalthoff.PARAMS)
 
 
+def test_a_resume_reads_runs_stored_before_a_parameter_existed(tmp_path):
+    """Runs stored before ``closure`` was a blanton parameter resume at its default (their
+    behaviour) and are refused, naming it, with another value."""
+    from rkfx.cases import blanton
+
+    stamp = fingerprint("blanton", blanton.PARAMS, parse_params(blanton.PARAMS), "rkpm")
+    old = {**stamp, "params": {k: v for k, v in stamp["params"].items() if k != "closure"}}
+    (tmp_path / "checkpoints").mkdir()
+    (tmp_path / "checkpoints" / _cli.FINGERPRINT).write_text(__import__("json").dumps(old))
+    assert _cli.check_resume(tmp_path, stamp, False, blanton.PARAMS)
+    with pytest.raises(ParameterError, match=r"closure = False \(now True\)"):
+        _cli.check_resume(tmp_path, {**stamp, "params": {**stamp["params"], "closure": True}}, False, blanton.PARAMS)
+
+
 def test_none_empties_a_list_and_an_empty_value_stays_an_error():
     """``--set nonlocal_h=none`` skips a study; ``--set h=`` is still refused in one line."""
     assert _cli.coerce("nonlocal_h", "none", [8e-4]) == []

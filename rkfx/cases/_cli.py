@@ -74,7 +74,9 @@ class Param:
 
     ``fingerprint=False`` marks a value that only chooses which runs exist (a list of levels or
     variants, each run stored under its own label): a resume may change it and keeps the
-    stored runs. Every other value is part of the fingerprint of the stored runs.
+    stored runs. Every other value is part of the fingerprint of the stored runs. A parameter
+    added to a case defaults to the case's behaviour before it: runs stored before it existed
+    resume as computed with its default.
     ``aliases``: older names that ``--set`` still takes for this parameter: a name (same value
     and unit) or an ``Alias`` (a value in other terms, converted); results and fingerprints
     use the parameter's own name, and a resume translates stored aliases the same way.
@@ -437,8 +439,8 @@ def check_resume(resume: Path, stamp: Mapping[str, Any], recompute: bool,
     if path.is_file():
         try:
             stored = json.loads(path.read_text())
-            if specs is not None:  # runs stored under a parameter's older name
-                stored["params"] = canonical(stored.get("params", {}), specs)
+            if specs is not None:  # runs stored under a parameter's older name, or before it existed
+                stored["params"] = _predating(canonical(stored.get("params", {}), specs), specs)
             diff = differences(stored, stamp)
         except (ValueError, AttributeError):
             diff = [f"{path} is unreadable"]
@@ -453,6 +455,14 @@ def check_resume(resume: Path, stamp: Mapping[str, Any], recompute: bool,
         logging.getLogger("rkfx").info("resume: %s: %s; computing every run again", resume, why)
         return False
     raise ParameterError(f"--resume {resume}: {why}; {fix}")
+
+
+def _predating(params: Mapping[str, Any], specs: Mapping[str, Param]) -> dict[str, Any]:
+    """``params`` with every fingerprinted parameter they lack at its default: a parameter added to
+    a case defaults to the case's behaviour before it, so runs stored before it existed were
+    computed as with its default."""
+    missing = {k: v.default for k, v in specs.items() if v.fingerprint and k not in params}
+    return {**params, **jsonable(missing)}
 
 
 def write_fingerprint(folder: Path, stamp: Mapping[str, Any]) -> list[Path]:
