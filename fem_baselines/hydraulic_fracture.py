@@ -588,7 +588,7 @@ class FemHydraulicFractureModel(DamageHistory):
         self.strain = eps
         self.trial = upd = self._damage(eps)
         st = upd.state
-        self._set(self._frac, np.maximum(1.0 - st.damage, self.residual_fraction))
+        self._set(self._frac, self.stiffness_fraction(st.damage))
         self._ku = _global_matrix(self._a_ku, self.comm)  # (1 - D) C, so f_int = K_D u (5.25)
         if self._kc_constant is None:
             self._set(self._alpha, self.rock.biot(st.damage))
@@ -598,7 +598,7 @@ class FemHydraulicFractureModel(DamageHistory):
         self._x = x
         f_u = self._ku @ u - self._kc @ P
         if self.closure is not None:  # int_e sigma_c : eps(v) with the element's mean strain
-            s_c = self.closure.stress(eps, _unit(st.normal), self._damaged_fraction(st))
+            s_c = self.closure.stress(eps, _unit(st.normal), 1.0 - self.stiffness_fraction(st.damage))
             f_u = f_u + sum(b.T @ (self.area * s_c[:, k]) for k, b in enumerate(self._B))
         if self.fracture is not None:
             f_u = f_u + self.fracture.forces(u, P)  # before the permeability: it reads the apertures
@@ -644,15 +644,11 @@ class FemHydraulicFractureModel(DamageHistory):
         k_pu = self._flow_derivative(on, dd) if self.jacobian == "full" else None
         return sp.bmat([[k_u, k_up], [k_pu, self._kh]], format="csr")
 
-    def _damaged_fraction(self, state: dm.DamageState) -> np.ndarray:
-        """The stiffness fraction the damage removed, 1 - max(1 - D, residual), per element."""
-        return 1.0 - np.maximum(1.0 - state.damage, self.residual_fraction)
-
     def _closure_stiffness(self) -> sp.csr_matrix:
         """sum_e A_e D M H(-eps_nn) (v . eps_e(du)) (v . eps_e(dv)) at the last residual."""
         st = self.trial.state
         normal = _unit(st.normal)
-        c = self.closure.normal_stiffness(self.strain, normal, self._damaged_fraction(st))
+        c = self.closure.normal_stiffness(self.strain, normal, 1.0 - self.stiffness_fraction(st.damage))
         on = np.flatnonzero(c)
         if on.size == 0:
             return sp.csr_matrix((self.n_u, self.n_u))

@@ -6,8 +6,8 @@ tracking, the admissions of the step's iterates in ``_trial_tracking`` (``(allow
 ``DamageHistory`` gives such a model the ``commit``, ``state`` and ``restore`` of the stepper
 protocol (``rkfx.solvers.model``): the RKPM hydraulic-fracture model and its crack-band FEM
 baseline share it. The model holds ``committed`` (a ``DamageState``), ``points`` (its
-``DamageModel``), ``allowed`` (or ``None`` without tracking), ``parent``, ``iterations`` (Newton
-iterations of every accepted step), ``_count`` (those of the step under way) and ``track`` (a
+``DamageModel``), ``residual_fraction`` (the least 1 - D), ``allowed`` (or ``None`` without
+tracking), ``parent``, ``iterations`` (Newton iterations of every accepted step), ``_count`` (those of the step under way) and ``track`` (a
 ``rkfx.fracture.tracking.Tracking``, or ``None``). A model with a pre-existing fracture sets
 ``fracture`` (a ``rkfx.fracture.contact.FractureContact``, whose slip is history too): it is
 committed, saved and restored with the damage.
@@ -114,6 +114,10 @@ class DamageHistory:
             done[new] = True
             upd = dm.update(self.points, self.committed, eps, allowed=allowed, **options)
         return upd
+
+    def stiffness_fraction(self, damage: np.ndarray) -> np.ndarray:
+        """1 - D kept at or above the model's ``residual_fraction``, per point."""
+        return np.maximum(1.0 - damage, self.residual_fraction)
 
     def opening(self, state: dm.DamageState | None = None) -> np.ndarray:
         """w / w_c = D kappa / kappa_c of every point (``rkfx.fracture.damage.crack_opening``) of

@@ -317,9 +317,6 @@ class HydraulicFractureModel(DamageHistory):
             q = q + float(rate(t)) * weights
         return f, q
 
-    def _stiffness_fraction(self, damage: np.ndarray) -> np.ndarray:
-        return np.maximum(1.0 - damage, self.residual_fraction)
-
     # ------------------------------------------------------------------ model protocol
 
     def _stabilization(self) -> sp.csr_matrix:
@@ -327,7 +324,7 @@ class HydraulicFractureModel(DamageHistory):
         subcell's particle: lagged by a step, so that the Jacobian stays consistent."""
         if self._k_stab is None or self._k_stab[0] is not self.committed:
             it = self.integration
-            frac = self._stiffness_fraction(self.committed.damage)
+            frac = self.stiffness_fraction(self.committed.damage)
             # MSCNI's grad-grad quadratures less plain SCNI: the subcell terms alone.
             quads = [*it.gradient_quads, replace(self.nodal, weights=-self.nodal.weights)]
             owners = [*it.gradient_owners, it.nodes]
@@ -343,7 +340,7 @@ class HydraulicFractureModel(DamageHistory):
         self.strain = eps
         self.trial = upd = self._damage(eps)
         st = upd.state
-        frac = self._stiffness_fraction(st.damage)
+        frac = self.stiffness_fraction(st.damage)
         stress = frac[:, None] * (eps @ self._C.T)
         if self.closure is not None:
             stress += self.closure.stress(eps, _unit(st.normal), 1.0 - frac)
@@ -367,7 +364,7 @@ class HydraulicFractureModel(DamageHistory):
         if self.closure is not None:
             st = self.trial.state
             tangent = tangent + self.closure.tangent(self.strain, _unit(st.normal),
-                                                     1.0 - self._stiffness_fraction(st.damage))
+                                                     1.0 - self.stiffness_fraction(st.damage))
         k_u = stiffness([self.nodal], [tangent]) + self._stabilization()
         k_up = -self._coupling
         if self.fracture is not None:
