@@ -60,13 +60,16 @@ def test_contributions_assemble_at_their_owners(ranks):
 @pytest.mark.mpi
 @pytest.mark.skipif(not MPIEXEC.exists() and shutil.which("mpiexec") is None, reason="no mpiexec")
 @pytest.mark.parametrize("ranks", [2, 3])
-def test_mandel_quick_on_ranks_is_the_serial_run(tmp_path, ranks):
-    """``mandel --quick`` (RKPM) on 1 rank and on 2 or 3: every series within 1e-10 of its
-    largest value (the early-time overshoots are round-off sized themselves: compared absolutely)."""
+@pytest.mark.parametrize("case", ["mandel", "liakopoulos"])
+def test_quick_runs_on_ranks_are_the_serial_run(tmp_path, case, ranks):
+    """``mandel --quick`` and ``liakopoulos --quick`` (RKPM: Biot on SCNI, unsaturated u-p on
+    NSNI, each rank integrating over its own nodes' cells) on 1 rank and on 2 or 3: every series
+    within 1e-10 of its largest value (the early-time overshoots are round-off sized
+    themselves: compared absolutely), the same Newton iterations."""
     import json
 
     mpiexec = str(MPIEXEC) if MPIEXEC.exists() else "mpiexec"
-    args = ["-m", "rkfx.cases.mandel", "--quick", "--method", "rkpm", "--out"]
+    args = ["-m", f"rkfx.cases.{case}", "--quick", "--method", "rkpm", "--out"]
     subprocess.run([sys.executable, *args, str(tmp_path / "serial")], check=True, timeout=300, capture_output=True)
     subprocess.run([mpiexec, "-n", str(ranks), sys.executable, *args, str(tmp_path / "parallel")], check=True,
                    timeout=300, capture_output=True)
@@ -78,11 +81,14 @@ def test_mandel_quick_on_ranks_is_the_serial_run(tmp_path, ranks):
             assert np.nanmax(np.abs(x - y)) <= 1e-10 * np.nanmax(np.abs(x)), (a["method"], key)
         for key, x in a["errors"].items():
             assert abs(x - b["errors"][key]) <= 1e-10 * max(abs(x), 1e-3), (a["method"], key)
+        assert a["info"].get("newton_iterations") == b["info"].get("newton_iterations"), a["method"]
 
 
 @pytest.mark.mpi
 @pytest.mark.skipif(not MPIEXEC.exists() and shutil.which("mpiexec") is None, reason="no mpiexec")
-def test_mandel_killed_on_two_ranks_resumes_on_two_ranks(tmp_path):
+@pytest.mark.parametrize(("case", "every", "run", "step"), [("mandel", 4, "rkpm-scni+fpp-profiles", 12),
+                                                          ("liakopoulos", 30, "rkpm-nsni", 90)])
+def test_killed_on_two_ranks_resumes_on_two_ranks(tmp_path, case, every, run, step):
     """The u-p runs are distributed (each rank steps its own unknowns, one checkpoint per rank):
     killed on 2 ranks after a checkpoint, refused on 3, resumed on 2 to the serial results."""
     import json
@@ -91,22 +97,22 @@ def test_mandel_killed_on_two_ranks_resumes_on_two_ranks(tmp_path):
     root = Path(__file__).resolve().parents[1]
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")]))
     mpiexec = str(MPIEXEC) if MPIEXEC.exists() else "mpiexec"
-    args = ["-m", "rkfx.cases.mandel", "--quick", "--method", "rkpm", "--checkpoint-every", "4"]
+    args = ["-m", f"rkfx.cases.{case}", "--quick", "--method", "rkpm", "--checkpoint-every", str(every)]
     out = tmp_path / "run"
     subprocess.run([sys.executable, *args, "--out", str(tmp_path / "serial")], check=True, timeout=300,
                    capture_output=True, env=env)
     killed = subprocess.run([mpiexec, "-n", "2", sys.executable, str(root / "tests" / "faults" / "killed_run.py"),
-                             str(out), "after-checkpoint", "3", "mandel"], timeout=300, capture_output=True, env=env)
+                             str(out), "after-checkpoint", "3", case], timeout=300, capture_output=True, env=env)
     assert killed.returncode != 0 and not (out / "results.json").exists()
-    run = out / "checkpoints" / "rkpm-scni+fpp-profiles"
-    assert sorted(p.name for p in run.iterdir() if p.is_dir()) == ["rank0-of-2", "rank1-of-2"]
+    folder = out / "checkpoints" / run
+    assert sorted(p.name for p in folder.iterdir() if p.is_dir()) == ["rank0-of-2", "rank1-of-2"]
     refused = subprocess.run([mpiexec, "-n", "3", sys.executable, *args, "--out", str(out), "--resume", str(out)],
                              timeout=300, capture_output=True, text=True, env=env)
     errors = [line for line in refused.stderr.splitlines() if "error" in line]
     assert refused.returncode != 0 and errors and "written on 2 ranks" in errors[0], refused.stderr[-2000:]
     resumed = subprocess.run([mpiexec, "-n", "2", sys.executable, *args, "--out", str(out), "--resume", str(out)],
                              timeout=300, capture_output=True, text=True, env=env, check=True)
-    assert "continues from step 12" in resumed.stderr
+    assert f"continues from step {step}" in resumed.stderr
     serial, parallel = (json.loads((d / "results.json").read_text())["runs"] for d in (tmp_path / "serial", out))
     for a, b in zip(serial, parallel, strict=True):
         for key, x in a["series"].items():

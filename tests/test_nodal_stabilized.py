@@ -15,6 +15,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spl
 
 from rkfx.approximation.semi_lagrangian import evaluate_moving, moving_rk
+from rkfx.approximation.sparse_rows import gathered_rows
 from rkfx.approximation.shape_functions import RKApproximation
 from rkfx.assembly import nodal_forms, operators
 from rkfx.errors import InputError
@@ -133,3 +134,32 @@ def test_bad_rules_and_missing_boundaries_are_named():
         nodal_integration(small, cells, bnd, "snni")
     with pytest.raises(InputError, match="volume"):
         nodal_cells(p.x, np.zeros(p.num_nodes))
+
+
+def _same_rows(a, b):
+    return (np.array_equal(a.indptr, b.indptr) and np.array_equal(a.indices, b.indices)
+            and np.array_equal(a.data, b.data) and a.num_cols == b.num_cols)
+
+
+@pytest.mark.parametrize("rule", sorted(RULES))
+def test_a_subset_of_points_gets_the_whole_rules_rows_there_bit_for_bit(rule):
+    """An MPI rank integrates over its own nodes' cells: rows, weights and moments at a subset
+    equal the whole rule's there, the VC-corrected test rows included (their column sums
+    gather every term of the whole rule's, in its order), here on a sheared jittered patch."""
+    p = jittered(13, 0.25, seed=3)
+    rk, cells, bnd = _set_up(p, _sheared(p))
+    whole = nodal_integration(rk, cells, bnd, rule)
+    points = np.flatnonzero(p.x[:, 0] < 0.3)  # a strip of the reference patch
+    part = nodal_integration(rk, cells, bnd, rule, points=points)
+    for name in ("values", "trial", "test", "trial_x", "trial_y"):
+        w = getattr(whole, name)
+        if w is None:
+            assert getattr(part, name) is None
+            continue
+        assert _same_rows(getattr(part, name), gathered_rows(w, points)), name
+    assert np.array_equal(part.weights, whole.weights[points])
+    assert (part.moments is None) == (whole.moments is None)
+    if whole.moments is not None:
+        assert np.array_equal(part.moments, whole.moments[points])
+    with pytest.raises(InputError, match="increasing node indices"):
+        nodal_integration(rk, cells, bnd, rule, points=points[::-1])

@@ -92,3 +92,29 @@ def test_bad_input_named():
         UnsaturatedBiotModel(d.rule, UnsaturatedSoil(SAND, Liakopoulos()), no_constraints(5))
     with pytest.raises(InputError, match="unequal spacings"):
         column_discretization(0.25, 1.0, 3, 11)
+
+
+@pytest.mark.parametrize("rule", ["nsni", "dni"])
+def test_the_contributions_of_a_split_of_the_points_add_up_to_the_whole_model(rule):
+    """What the MPI ranks rely on (each integrates over its own nodes' cells and the steppers add
+    the contributions): residual, rate terms and their Jacobians of the models on two halves of
+    the points sum to the whole model's."""
+    from rkfx.integration.nodal_stabilized import boundary_rule, nodal_cells, nodal_integration
+
+    d, whole = model(rule=rule)
+    p, soil = d.particles, whole.soil
+    cells = nodal_cells(p.x, whole.rule.weights)
+    halves = np.array_split(np.arange(p.num_nodes), 2)
+    parts = [UnsaturatedBiotModel(nodal_integration(d.rk, cells, boundary_rule(p.x, p.boundary_edges), rule, points=h),
+                                  soil, no_constraints(3 * p.num_nodes)) for h in halves]
+    assert [len(m.rule.weights) for m in parts] == [len(h) for h in halves]
+    x, v = state(d)
+    scale = lambda a: np.abs(a).max()  # noqa: E731
+    r = whole.residual(x, 0.0)
+    assert scale(sum(m.residual(x, 0.0) for m in parts) - r) <= 1e-12 * scale(r)
+    k = whole.tangent(x, 0.0)
+    assert abs(sum(m.tangent(x, 0.0) for m in parts) - k).max() <= 1e-12 * abs(k).max()
+    f = whole.rate_force(x, v)
+    assert scale(sum(m.rate_force(x, v) for m in parts) - f) <= 1e-12 * scale(f)
+    for a, b in zip(whole.rate_tangents(), zip(*(m.rate_tangents() for m in parts))):
+        assert abs(sum(b) - a).max() <= 1e-12 * abs(a).max()

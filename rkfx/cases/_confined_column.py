@@ -18,6 +18,8 @@ from rkfx.geometry.nodal_domains import nodal_domains
 from rkfx.geometry.particles import Particles, structured
 from rkfx.integration.nodal_stabilized import NodalIntegration, boundary_rule, nodal_cells, nodal_integration
 from rkfx.models.explicit_poroelasticity import Constituents, ExplicitPoroDynamics, collocation_rows
+from rkfx.parallel.ownership import Numbering, numbering
+from rkfx.parallel.partition import rcb
 from rkfx.solvers.central_difference import Constraint
 
 #: The data of §6.4.1 (Soares 2014).
@@ -26,7 +28,8 @@ SOARES = Constituents(E=254423076.9, nu=0.298, rho_s=2700.0, rho_f=1000.0, poros
 
 
 class ColumnDiscretization(NamedTuple):
-    """Nodes, approximation and rule of a column, and its boundary nodes (indices)."""
+    """Nodes, approximation and rule of a column, and its boundary nodes (indices); on MPI
+    ranks the rank's own nodes (whose cells its rule covers) and the partition's numbering."""
 
     particles: Particles
     rk: MovingRK
@@ -34,10 +37,15 @@ class ColumnDiscretization(NamedTuple):
     bottom: np.ndarray
     top: np.ndarray
     sides: np.ndarray
+    own: np.ndarray | None = None
+    numbering: Numbering | None = None
 
 
-def column_discretization(width: float, height: float, nx: int, ny: int, rule: str = "nsni") -> ColumnDiscretization:
-    """``nx`` x ``ny`` nodes on [0, width] x [0, height] with equal spacings h, a = 2 h."""
+def column_discretization(width: float, height: float, nx: int, ny: int, rule: str = "nsni",
+                          comm=None) -> ColumnDiscretization:
+    """``nx`` x ``ny`` nodes on [0, width] x [0, height] with equal spacings h, a = 2 h. On a
+    communicator of several ranks the nodes are split by RCB and the rule covers the cells of
+    the rank's own nodes only (``own``, ``numbering``); otherwise every node's."""
     h = height / (ny - 1)
     if abs(width / (nx - 1) - h) > 1e-9 * h:
         raise InputError(f"nx = {nx}, ny = {ny} give unequal spacings {width / (nx - 1):.4g} and {h:.4g} m on a "
@@ -45,10 +53,14 @@ def column_discretization(width: float, height: float, nx: int, ny: int, rule: s
     p = structured(width, height, nx, ny)
     cells = nodal_cells(p.x, nodal_domains(p).area)
     rk = moving_rk(p.x, 2.0 * h, 0.5 * h, reach=cells.reach)
-    r = nodal_integration(rk, cells, boundary_rule(p.x, p.boundary_edges), rule)
+    num = own = None
+    if comm is not None and comm.size > 1:
+        num = numbering(rcb(p.x, comm.size), comm.size)
+        own = np.sort(num.old_of_new[num.ranges[comm.rank]:num.ranges[comm.rank + 1]])
+    r = nodal_integration(rk, cells, boundary_rule(p.x, p.boundary_edges), rule, points=own)
     x, tol = p.x, 1e-9 * height
     return ColumnDiscretization(p, rk, r, np.flatnonzero(x[:, 1] < tol), np.flatnonzero(x[:, 1] > height - tol),
-                                np.flatnonzero((x[:, 0] < tol) | (x[:, 0] > width - tol)))
+                                np.flatnonzero((x[:, 0] < tol) | (x[:, 0] > width - tol)), own, num)
 
 
 class ConfinedColumn(NamedTuple):
@@ -80,7 +92,7 @@ def confined_column(ny: int, rule: str = "nsni", medium: Constituents = SOARES, 
         load: q [Pa], compressive, on the top from t = 0.
     """
     h = height / (ny - 1)
-    p, rk, r, bottom, top, sides = column_discretization(2 * h, height, 3, ny, rule)
+    p, rk, r, bottom, top, sides, _, _ = column_discretization(2 * h, height, 3, ny, rule)
     x, n = p.x, p.num_nodes
     size = 3 * n
     tol = 1e-9 * height

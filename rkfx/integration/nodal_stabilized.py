@@ -25,9 +25,10 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
+from scipy.spatial import cKDTree
 
 from rkfx.approximation.semi_lagrangian import MovingRK, evaluate_moving
-from rkfx.approximation.sparse_rows import SparseRows, combine_rows
+from rkfx.approximation.sparse_rows import SparseRows, combine_rows, gathered_rows
 from rkfx.errors import InputError
 
 # name: (smoothed gradients, natural stabilization, corrected test gradients)
@@ -151,15 +152,27 @@ class NodalIntegration:
     trial_y: SparseRows | None
     name: str
 
+    def renumbered(self, column: np.ndarray, num_cols: int) -> "NodalIntegration":
+        """The same rows over renumbered columns (an MPI rank's local nodes): ``column`` gives
+        the new index of every old one (entries of columns the rows never touch are unused)."""
+        rows = {name: None if (r := getattr(self, name)) is None
+                else gathered_rows(r, np.arange(r.num_rows), column, num_cols)
+                for name in ("values", "trial", "test", "trial_x", "trial_y")}
+        return NodalIntegration(self.weights, moments=self.moments, name=self.name, **rows)
 
-def smoothed_gradients(rk: MovingRK, cells: NodalCells) -> SparseRows:
-    """SNNI gradients (6.68): ``(1 / V_L) sum_q N_I(y_q) n_q w_q`` over the sides of each square."""
+
+def smoothed_gradients(rk: MovingRK, cells: NodalCells, nodes: np.ndarray | None = None) -> SparseRows:
+    """SNNI gradients (6.68): ``(1 / V_L) sum_q N_I(y_q) n_q w_q`` over the sides of each square
+    (of every node, or of ``nodes`` only, one row each in their order)."""
     if cells.reach > rk.reach * (1 + 1e-12):
         raise InputError(f"the smoothing cells reach {cells.reach:.4g} from their nodes but the approximation "
                          f"was built with reach = {rk.reach:.4g}; pass reach >= the largest half-diagonal")
+    if nodes is not None:
+        cells = NodalCells(cells.center[nodes], cells.volume[nodes])
     points, nl = cells.smoothing_points()
     n = len(cells.volume)
-    values = evaluate_moving(rk, points, np.repeat(np.arange(n), 4))
+    owner = np.repeat(np.arange(n) if nodes is None else nodes, 4)
+    values = evaluate_moving(rk, points, owner)
     weight = nl / np.repeat(cells.volume, 4)[:, None]
     return combine_rows(values, 4 * np.arange(n + 1), np.arange(4 * n), weight)
 
@@ -216,10 +229,11 @@ def _plus_columns(data, indices, zeta, out):
             out[e, k] = data[e, k] + zeta[indices[e], k]
 
 
-def second_gradient_rows(rk: MovingRK) -> tuple[SparseRows, SparseRows]:
-    """Rows [N_I,xx, N_I,yx] and [N_I,xy, N_I,yy] at the nodes: the derivatives of the implicit
-    gradients (``evaluate_moving(second=True)``), the x- and y-derivatives of the gradient rows."""
-    s = evaluate_moving(rk, second=True)
+def second_gradient_rows(rk: MovingRK, nodes: np.ndarray | None = None) -> tuple[SparseRows, SparseRows]:
+    """Rows [N_I,xx, N_I,yx] and [N_I,xy, N_I,yy] at the nodes (or at ``nodes`` only): the
+    derivatives of the implicit gradients (``evaluate_moving(second=True)``), the x- and
+    y-derivatives of the gradient rows."""
+    s = evaluate_moving(rk, second=True) if nodes is None else evaluate_moving(rk, rk.x[nodes], nodes, second=True)
     # entries [N, gx, gy, gx_x, gx_y, gy_x, gy_y]
     dx = SparseRows(s.indptr, s.indices, np.ascontiguousarray(s.data[:, [3, 5]]), s.num_cols)
     dy = SparseRows(s.indptr, s.indices, np.ascontiguousarray(s.data[:, [4, 6]]), s.num_cols)
@@ -227,7 +241,7 @@ def second_gradient_rows(rk: MovingRK) -> tuple[SparseRows, SparseRows]:
 
 
 def nodal_integration(rk: MovingRK, cells: NodalCells, boundary: BoundaryRule | None = None,
-                      rule: str = "nsni") -> NodalIntegration:
+                      rule: str = "nsni", points: np.ndarray | None = None) -> NodalIntegration:
     """The rows of one nodal integration rule in the current configuration.
 
     Args:
@@ -235,24 +249,57 @@ def nodal_integration(rk: MovingRK, cells: NodalCells, boundary: BoundaryRule | 
         cells: The nodes' cells (centres = ``rk.x``).
         boundary: The domain boundary, needed by the corrected rules (``snni-vc``, ``nsni``).
         rule: One of ``RULES``.
+        points: Integrate over the cells of these nodes only (an MPI rank's own nodes, say;
+            increasing): the rule's rows at them, equal bit for bit to the whole rule's rows
+            there. With the correction, the gradients are also evaluated at every node whose
+            rows may reach the points' columns, so that their column sums (6.71) hold every
+            term of the whole rule's, in its order. ``None``: every node.
     """
     if rule not in RULES:
         raise InputError(f"unknown nodal integration rule {rule!r}; choose one of {', '.join(RULES)}")
     smoothed, stabilized, correct = RULES[rule]
     if correct and boundary is None:
         raise InputError(f"rule {rule!r} corrects the test gradients against int_Gamma N n: pass the boundary")
-    if smoothed:
-        values, trial = evaluate_moving(rk), smoothed_gradients(rk, cells)
-    else:
-        rows = evaluate_moving(rk, gradients=True)
-        values = rows.component(0)
-        trial = SparseRows(rows.indptr, rows.indices, np.ascontiguousarray(rows.data[:, 1:]), rows.num_cols)
+    if points is not None:
+        points = np.asarray(points, dtype=np.int64)
+        n = rk.num_nodes
+        if points.ndim != 1 or np.any(np.diff(points) <= 0) or (points.size and (points[0] < 0 or points[-1] >= n)):
+            raise InputError(f"points must be increasing node indices in [0, {n}): {points.size} given, out of "
+                             "order or range")
+    values, trial = _gradient_rows(rk, cells, smoothed, points)
     test = trial
     if correct:
         gamma = evaluate_moving(rk, boundary.points, boundary.owner)
-        test = corrected(trial, vc_correction(trial, cells.volume, gamma, boundary))
+        if points is None:
+            zeta = vc_correction(trial, cells.volume, gamma, boundary)
+        else:
+            around = _reaching(rk, cells, trial.indices)
+            zeta = vc_correction(_gradient_rows(rk, cells, smoothed, around)[1], cells.volume[around], gamma, boundary)
+        test = corrected(trial, zeta)
     moments = trial_x = trial_y = None
     if stabilized:
-        trial_x, trial_y = second_gradient_rows(rk)
-        moments = cells.second_moments
-    return NodalIntegration(cells.volume, values, trial, test, moments, trial_x, trial_y, rule)
+        trial_x, trial_y = second_gradient_rows(rk, points)
+        moments = cells.second_moments if points is None else cells.second_moments[points]
+    weights = cells.volume if points is None else cells.volume[points]
+    return NodalIntegration(weights, values, trial, test, moments, trial_x, trial_y, rule)
+
+
+def _gradient_rows(rk: MovingRK, cells: NodalCells, smoothed: bool,
+                   nodes: np.ndarray | None) -> tuple[SparseRows, SparseRows]:
+    """Value rows at the nodes and trial gradient rows (smoothed or direct) of their cells, at
+    ``nodes`` (every node when ``None``)."""
+    at = () if nodes is None else (rk.x[nodes], nodes)
+    if smoothed:
+        return evaluate_moving(rk, *at), smoothed_gradients(rk, cells, nodes)
+    rows = evaluate_moving(rk, *at, gradients=True)
+    return rows.component(0), SparseRows(rows.indptr, rows.indices, np.ascontiguousarray(rows.data[:, 1:]),
+                                         rows.num_cols)
+
+
+def _reaching(rk: MovingRK, cells: NodalCells, columns: np.ndarray) -> np.ndarray:
+    """The nodes (increasing) whose cells' evaluation points may lie in the support of any of
+    ``columns``: those within a_J plus the cells' reach of a node J of them."""
+    columns = np.unique(columns)
+    radius = (rk.support[columns] + cells.reach) * (1.0 + 1e-12)
+    found = cKDTree(rk.x).query_ball_point(rk.x[columns], radius, return_sorted=False)
+    return np.unique(np.concatenate([np.asarray(f, np.int64) for f in found] + [np.zeros(0, np.int64)]))

@@ -39,6 +39,7 @@ from rkfx.errors import InputError
 from rkfx.integration.nodal_stabilized import NodalIntegration
 from rkfx.materials.retention import Retention, storage, storage_slope
 from rkfx.models.explicit_poroelasticity import Constituents
+from rkfx.parallel.unknowns import LocalUnknowns
 from rkfx.solvers.fields import layout
 from rkfx.solvers.model import Constraints, Stateless
 
@@ -93,10 +94,24 @@ class UnsaturatedBiotModel(Stateless):
     Args:
         rule: The nodal integration of the (fixed) particles.
         soil: Constituents, retention law and gravity.
-        constraints: Collocation rows G x = g of the essential conditions (constant).
+        constraints: Collocation rows G x = g of the essential conditions (constant), over
+            the model's unknowns (with ``local``, the rank's own constraint rows over its local
+            unknowns).
+        local: On MPI ranks, the rank's local unknowns (``rkfx.parallel.unknowns``) and
+            ``rule`` its own points' rows over the whole node set
+            (``nodal_integration(..., points=)``): the model then lives on the local nodes and
+            returns the contributions of its points (``share`` tells the steppers, which add
+            them up). ``None``: the whole model.
     """
 
-    def __init__(self, rule: NodalIntegration, soil: UnsaturatedSoil, constraints: Constraints):
+    def __init__(self, rule: NodalIntegration, soil: UnsaturatedSoil, constraints: Constraints,
+                 local: LocalUnknowns | None = None):
+        self.local = local
+        self.share = None if local is None else local.share
+        if local is not None:
+            column = np.full(rule.values.num_cols, -1, np.int64)
+            column[local.nodes] = np.arange(len(local.nodes))
+            rule = rule.renumbered(column, len(local.nodes))
         n = rule.values.num_cols
         self.n, self.rule, self.soil = n, rule, soil
         self.layout = layout(("u", 2, 1), ("p", 1, 1), nodes=n)
@@ -141,11 +156,11 @@ class UnsaturatedBiotModel(Stateless):
     # ------------------------------------------------------------------ fields
 
     def pressures(self, x: np.ndarray) -> np.ndarray:
-        """p^h at the nodes, shape ``(n,)`` [Pa]."""
+        """p^h at the integration points (the nodes, or a rank's own), shape ``(num_points,)`` [Pa]."""
         return self.N @ x[2 * self.n:]
 
     def saturation(self, x: np.ndarray) -> np.ndarray:
-        """S_w at the nodes, shape ``(n,)``."""
+        """S_w at the integration points, shape ``(num_points,)``."""
         return self.soil.retention.saturation(-self.pressures(x))
 
     # ------------------------------------------------------------------ model

@@ -10,7 +10,7 @@ POINT is where the process dies:
                       before the new one replaces checkpoint.npz;
     mid-result        half-way through writing a finished run's result.npz (N-th run);
     never             run to the end.
-CASE is ``kalthoff`` (default) or ``mandel``; under mpiexec every rank dies at its own N-th
+CASE is ``kalthoff`` (default), ``mandel`` or ``liakopoulos``; under mpiexec every rank dies at its own N-th
 checkpoint (one file per rank).
 """
 import importlib
@@ -26,7 +26,8 @@ from rkfx.solvers import checkpoint
 ARGS = ["--method", "rkpm", "--set", "h=2.564e-3", "unregularized_h=2.564e-3", "no_tracking_h=2.564e-3", "nonlocal_h=none",
         "t_end=2e-5", "--checkpoint-every", "20"]
 MANDEL_ARGS = ["--quick", "--method", "rkpm", "--checkpoint-every", "4"]
-CASE_ARGS = {"kalthoff": ARGS, "mandel": MANDEL_ARGS}
+LIAKOPOULOS_ARGS = ["--quick", "--method", "rkpm", "--checkpoint-every", "30"]
+CASE_ARGS = {"kalthoff": ARGS, "mandel": MANDEL_ARGS, "liakopoulos": LIAKOPOULOS_ARGS}
 
 
 def die():
