@@ -39,3 +39,26 @@ def test_the_base_sees_twice_the_undrained_pressure_after_the_fast_wave():
 def test_incompressible_constituents_are_refused():
     with pytest.raises(InputError, match="porosity"):
         Constituents(1e8, 0.3, 2700.0, 1000.0, 1.2, 1e-9, 1e10, 3e9)
+
+
+def test_the_contributions_of_a_split_of_the_points_add_up_to_the_whole_model():
+    """What the MPI ranks rely on (each integrates over its own nodes' cells and the stepper adds
+    the contributions): masses, forces and fluxes of the models on two halves of the points sum
+    to the whole model's."""
+    from rkfx.cases._confined_column import column_discretization
+    from rkfx.integration.nodal_stabilized import boundary_rule, nodal_cells, nodal_integration
+    from rkfx.models.explicit_poroelasticity import ExplicitPoroDynamics
+
+    d = column_discretization(0.2, 2.0, 3, 21, "nsni")
+    p = d.particles
+    whole = ExplicitPoroDynamics(d.rule, SOARES)
+    cells = nodal_cells(p.x, d.rule.weights)
+    parts = [ExplicitPoroDynamics(nodal_integration(d.rk, cells, boundary_rule(p.x, p.boundary_edges), "nsni",
+                                                    points=h), SOARES)
+             for h in np.array_split(np.arange(p.num_nodes), 2)]
+    rng = np.random.default_rng(1)
+    u, v, q = rng.standard_normal(2 * p.num_nodes), rng.standard_normal(2 * p.num_nodes), rng.standard_normal(p.num_nodes)
+    for name, call in [("mass", lambda m: m.lumped_mass()), ("solid", lambda m: m.solid_force(u, q)),
+                       ("fluid", lambda m: m.fluid_flux(v, q))]:
+        a = call(whole)
+        assert np.abs(sum(call(m) for m in parts) - a).max() <= 1e-12 * np.abs(a).max(), name

@@ -6,6 +6,9 @@ their median-dual areas as squares, and any rule of ``rkfx.integration.nodal_sta
 ``confined_column``: the wave-column model, three nodes across (rollers on both sides), the
 base fixed in y and impermeable, the top drained (p = 0) and loaded by a compressive traction
 q from t = 0.
+
+On a communicator of several ranks the nodes are split by RCB: each rank's rule covers its own
+nodes' cells only, and ``column_unknowns`` gives its local unknowns (own nodes, then ghosts).
 """
 from typing import NamedTuple
 
@@ -20,6 +23,7 @@ from rkfx.integration.nodal_stabilized import NodalIntegration, boundary_rule, n
 from rkfx.models.explicit_poroelasticity import Constituents, ExplicitPoroDynamics, collocation_rows
 from rkfx.parallel.ownership import Numbering, numbering
 from rkfx.parallel.partition import rcb
+from rkfx.parallel.unknowns import LocalUnknowns, local_unknowns
 from rkfx.solvers.central_difference import Constraint
 
 #: The data of §6.4.1 (Soares 2014).
@@ -63,15 +67,26 @@ def column_discretization(width: float, height: float, nx: int, ny: int, rule: s
                                 np.flatnonzero((x[:, 0] < tol) | (x[:, 0] > width - tol)), own, num)
 
 
+def column_unknowns(d: ColumnDiscretization, constraints: sp.spmatrix, comm) -> LocalUnknowns:
+    """On MPI ranks, a rank's local u-p unknowns (``u`` interleaved, then ``p``) of a column split
+    by ``column_discretization(..., comm=)``: its own nodes, then the ghosts its rule's rows and
+    the ``constraints`` rows (over the whole vector) touch. Collective."""
+    n = d.particles.num_nodes
+    cols = sp.csr_matrix(constraints).indices
+    touched = np.unique(np.r_[d.own, np.where(cols < 2 * n, cols // 2, cols - 2 * n), d.rule.columns()])
+    return local_unknowns(d.numbering, touched, (2, 1), comm)
+
+
 class ConfinedColumn(NamedTuple):
     """The column's model and where it is observed.
 
     Attributes:
-        model: The explicit u-p model.
+        model: The explicit u-p model (on MPI ranks the rank's part, ``model.share``).
         top: A node on the top (index).
         base: A node on the base (index).
-        probe: Rows over the whole vector giving [u_y^h, p^h] on the axis at the top and at
-            the base: ``probe @ x`` = [u_y(W/2, L), p(W/2, 0)].
+        probe: Rows over the model's vector giving [u_y^h, p^h] on the axis at the top and at
+            the base: ``probe @ x`` = [u_y(W/2, L), p(W/2, 0)]; on ranks over the rank's local
+            vector with its owned unknowns' terms only (their sum over the ranks is the value).
     """
 
     model: ExplicitPoroDynamics
@@ -81,7 +96,7 @@ class ConfinedColumn(NamedTuple):
 
 
 def confined_column(ny: int, rule: str = "nsni", medium: Constituents = SOARES, height: float = 10.0,
-                    load: float = 3000.0) -> ConfinedColumn:
+                    load: float = 3000.0, comm=None) -> ConfinedColumn:
     """The model of a column of ``ny`` nodes along y, two of its nodes and its probe.
 
     Args:
@@ -90,15 +105,19 @@ def confined_column(ny: int, rule: str = "nsni", medium: Constituents = SOARES, 
         medium: The constituents.
         height: L [m].
         load: q [Pa], compressive, on the top from t = 0.
+        comm: On a communicator of several ranks the model is split over them (RCB): each rank
+            integrates over its own nodes' cells and keeps the rows of every essential
+            condition over its local unknowns (the columns of the conditions are its ghosts).
     """
     h = height / (ny - 1)
-    p, rk, r, bottom, top, sides, _, _ = column_discretization(2 * h, height, 3, ny, rule)
+    d = column_discretization(2 * h, height, 3, ny, rule, comm=comm)
+    p, rk, r, bottom, top, sides = d.particles, d.rk, d.rule, d.bottom, d.top, d.sides
     x, n = p.x, p.num_nodes
     size = 3 * n
     tol = 1e-9 * height
-    essential = [Constraint(collocation_rows(rk, bottom, 1, n, 0, size)),      # u_y = 0 at the base
-                 Constraint(collocation_rows(rk, sides, 0, n, 0, size)),       # rollers
-                 Constraint(collocation_rows(rk, top, None, n, 2 * n, size))]  # drained top
+    rows = [collocation_rows(rk, bottom, 1, n, 0, size),      # u_y = 0 at the base
+            collocation_rows(rk, sides, 0, n, 0, size),       # rollers
+            collocation_rows(rk, top, None, n, 2 * n, size)]  # drained top
     top_edges = p.boundary_edges[np.all(x[p.boundary_edges][:, :, 1] > height - tol, axis=1)]
     tb = boundary_rule(x, top_edges)
     f = np.zeros(size)
@@ -106,5 +125,13 @@ def confined_column(ny: int, rule: str = "nsni", medium: Constituents = SOARES, 
     axis = np.abs(x[:, 0] - h) < tol
     probe = sp.vstack([collocation_rows(rk, np.flatnonzero(axis & (x[:, 1] > height - tol)), 1, n, 0, size),
                        collocation_rows(rk, np.flatnonzero(axis & (x[:, 1] < tol)), None, n, 2 * n, size)]).tocsr()
-    return ConfinedColumn(ExplicitPoroDynamics(r, medium, essential, load=lambda t: f), int(top[0]),
+    local = None
+    if d.own is not None:
+        local = column_unknowns(d, sp.vstack(rows), comm)
+        rows = [g[:, local.index].tocsr() for g in rows]
+        owned = np.zeros(len(local.index), bool)
+        owned[local.share.owned] = True
+        probe = (probe[:, local.index] @ sp.diags(owned.astype(float))).tocsr()
+    essential = [Constraint(g) for g in rows]
+    return ConfinedColumn(ExplicitPoroDynamics(r, medium, essential, load=lambda t: f, local=local), int(top[0]),
                           int(bottom[0]), probe)

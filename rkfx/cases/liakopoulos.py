@@ -66,14 +66,13 @@ from scipy.spatial import cKDTree
 from rkfx.approximation.semi_lagrangian import evaluate_moving
 from rkfx.cases import _cli, _preflight
 from rkfx.cases._cli import Param, Results, Run
-from rkfx.cases._confined_column import column_discretization
+from rkfx.cases._confined_column import column_discretization, column_unknowns
 from rkfx.conditions import Displacement, Pressure
 from rkfx.errors import InputError
 from rkfx.integration.nodal_stabilized import RULES
 from rkfx.materials.retention import Liakopoulos
 from rkfx.models.explicit_poroelasticity import Constituents, collocation_rows
 from rkfx.models.unsaturated_poroelasticity import UnsaturatedBiotModel, UnsaturatedSoil
-from rkfx.parallel.unknowns import local_unknowns
 from rkfx.report.claims import Claim
 from rkfx.solvers.integrate import integrate, time_grid
 from rkfx.solvers.model import Constraints
@@ -191,10 +190,7 @@ def _rkpm(soil, W, L, ny, rule, times, points, io):
     rows = evaluate_moving(d.rk, points, nearest).matrix().tocsr()
     local = None
     if ranks:
-        r = d.rule
-        touched = np.unique(np.concatenate([d.own, np.where(G.indices < 2 * n, G.indices // 2, G.indices - 2 * n)] + [
-            rr.indices for rr in (r.values, r.trial, r.test, r.trial_x, r.trial_y) if rr is not None]))
-        local = local_unknowns(d.numbering, touched, (2, 1), comm)
+        local = column_unknowns(d, G, comm)
         G = G[:, local.index].tocsr()
         nl, no = len(local.nodes), local.num_owned_nodes
         owned = local.nodes[:no]

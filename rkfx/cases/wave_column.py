@@ -145,19 +145,23 @@ def _errors(exact: WaveColumn, t: np.ndarray, u: np.ndarray, p: np.ndarray, excl
 def _rkpm(medium, L, q, ny, rule, t_end, courant, samples, io):
     """The RKPM history: times, u_y(L), p(0), and what the run measured."""
     t0 = time.perf_counter()
-    model, _, _, probe = confined_column(ny, rule, medium, L, q)
+    comm = _cli.comm()
+    model, _, _, probe = confined_column(ny, rule, medium, L, q, comm=comm)
     limits = stable_steps(model)
+    # On ranks the probe holds each rank's owned terms: their sum is the value.
+    total = (lambda v: v) if model.share is None else (lambda v: comm.allreduce(v))
     steps = int(np.ceil(t_end / (courant * limits["coupled"])))
     dt = t_end / steps
     bar = _cli.step_progress(f"rkpm-{rule} ny={ny}", steps)
     try:
-        run = ExplicitUP(dt, check_stability=False).run(model, steps, record=lambda x, r, t: probe @ x,
+        run = ExplicitUP(dt, check_stability=False).run(model, steps, record=lambda x, r, t: total(probe @ x),
                                                         record_every=max(1, steps // samples), progress=bar,
-                                                        comm=_cli.comm(), **io)
+                                                        comm=comm, **io)
     finally:
         bar.close()
     info = {"dt": dt, "steps": steps, "wave_limit": limits["wave"], "diffusion_limit": limits["diffusion"],
-            "governs": limits["governs"], "unknowns": model.layout.size}
+            "governs": limits["governs"],
+            "unknowns": model.layout.size if model.share is None else int(model.share.total(model.share.num_owned))}
     return run.times, run.samples[:, 0], run.samples[:, 1], time.perf_counter() - t0, info
 
 

@@ -152,11 +152,21 @@ class NodalIntegration:
     trial_y: SparseRows | None
     name: str
 
-    def renumbered(self, column: np.ndarray, num_cols: int) -> "NodalIntegration":
-        """The same rows over renumbered columns (an MPI rank's local nodes): ``column`` gives
-        the new index of every old one (entries of columns the rows never touch are unused)."""
+    def columns(self) -> np.ndarray:
+        """The nodes that any of the rows touches, increasing."""
+        rows = [r.indices for r in (self.values, self.trial, self.test, self.trial_x, self.trial_y) if r is not None]
+        return np.unique(np.concatenate(rows))
+
+    def localized(self, nodes: np.ndarray) -> "NodalIntegration":
+        """The same rows over the local nodes ``nodes`` (an MPI rank's: indices into the whole
+        node set, covering ``columns()``), column j standing for node ``nodes[j]``."""
+        nodes = np.asarray(nodes, np.int64)
+        column = np.full(self.values.num_cols, -1, np.int64)
+        column[nodes] = np.arange(len(nodes))
+        if np.any(column[self.columns()] < 0):
+            raise InputError("localized: the local nodes do not cover every column of the rule's rows")
         rows = {name: None if (r := getattr(self, name)) is None
-                else gathered_rows(r, np.arange(r.num_rows), column, num_cols)
+                else gathered_rows(r, np.arange(r.num_rows), column, len(nodes))
                 for name in ("values", "trial", "test", "trial_x", "trial_y")}
         return NodalIntegration(self.weights, moments=self.moments, name=self.name, **rows)
 

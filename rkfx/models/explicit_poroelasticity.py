@@ -21,6 +21,7 @@ from rkfx.assembly import nodal_forms
 from rkfx.errors import InputError
 from rkfx.integration.nodal_stabilized import NodalIntegration
 from rkfx.models.poroelasticity import PoroMaterial
+from rkfx.parallel.unknowns import LocalUnknowns
 from rkfx.solvers.central_difference import Constraint
 from rkfx.solvers.fields import layout
 
@@ -92,10 +93,21 @@ class ExplicitPoroDynamics:
         medium: Constituents of the saturated medium.
         essential: Essential conditions (collocation rows, ``collocation_rows``).
         load: f_ext over the whole vector at time t, or ``None``.
+        local: On MPI ranks, the rank's local unknowns (``rkfx.parallel.unknowns``) and ``rule``
+            its own points' rows over the whole node set (``nodal_integration(..., points=)``):
+            masses, forces and fluxes are then the contributions of the rank's points over its
+            local unknowns, the load the owned entries of ``load``'s (``share`` tells the
+            stepper, which adds them up), and ``essential`` holds every condition's rows over
+            the local unknowns (the rank's local nodes cover their columns). ``None``: the
+            whole model.
     """
 
     def __init__(self, rule: NodalIntegration, medium: Constituents, essential: Sequence[Constraint] = (),
-                 load=None):
+                 load=None, local: LocalUnknowns | None = None):
+        self.local = local
+        self.share = None if local is None else local.share
+        if local is not None:
+            rule = rule.localized(local.nodes)
         n = rule.values.num_cols
         mat = medium.material
         self.layout = layout(("u", 2, 2), ("p", 1, 1), nodes=n)
@@ -108,13 +120,16 @@ class ExplicitPoroDynamics:
         self.H = nodal_forms.laplacian(rule, mat.k)
         volume = nodal_forms.lumped(rule)
         bad = np.flatnonzero(~(volume > 0))
-        if bad.size:
+        if bad.size and rule.values.num_rows == n:  # a part of the points: the stepper checks the summed masses
             raise InputError(f"node {bad[0]} has a non-positive lumped volume {volume[bad[0]]:.3g}; "
                              "the supports are too small for the node set (raise the support factor)")
         self._mass = np.concatenate([np.repeat(medium.density * volume, 2), mat.S * volume])
         if not mat.S > 0:
             raise InputError("explicit u-p stepping needs compressible constituents (1/Q > 0) for the pressure mass")
         self._load = load
+        if local is not None:
+            self._owned = np.zeros(self.layout.size, bool)
+            self._owned[local.share.owned] = True
 
     def lumped_mass(self) -> np.ndarray:
         return self._mass
@@ -126,4 +141,7 @@ class ExplicitPoroDynamics:
         return self.C_pu @ v + self.H @ p
 
     def external_force(self, t: float) -> np.ndarray | None:
-        return None if self._load is None else self._load(t)
+        if self._load is None:
+            return None
+        f = self._load(t)
+        return f if self.local is None else np.where(self._owned, np.asarray(f)[self.local.index], 0.0)

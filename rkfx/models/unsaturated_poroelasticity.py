@@ -109,9 +109,7 @@ class UnsaturatedBiotModel(Stateless):
         self.local = local
         self.share = None if local is None else local.share
         if local is not None:
-            column = np.full(rule.values.num_cols, -1, np.int64)
-            column[local.nodes] = np.arange(len(local.nodes))
-            rule = rule.renumbered(column, len(local.nodes))
+            rule = rule.localized(local.nodes)
         n = rule.values.num_cols
         self.n, self.rule, self.soil = n, rule, soil
         self.layout = layout(("u", 2, 1), ("p", 1, 1), nodes=n)

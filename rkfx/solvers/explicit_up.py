@@ -47,7 +47,7 @@ import numpy as np
 
 from rkfx.errors import InputError
 from rkfx.solvers.central_difference import Constraint, _Projection
-from rkfx.solvers.checkpoint import has_checkpoint, load_arrays, save_arrays
+from rkfx.solvers.checkpoint import RankFiles, has_checkpoint, save_arrays
 from rkfx.solvers.fields import FieldLayout
 
 
@@ -99,40 +99,75 @@ class ExplicitUPRun:
     resumed_from: int | None = None
 
 
-def _power_iteration(apply: Callable[[np.ndarray], np.ndarray], n: int, iterations: int = 60,
-                     seed: int = 0) -> float:
-    """Largest eigenvalue of a symmetric-positive operator (in its mass metric) by power iteration."""
-    w = np.random.default_rng(seed).standard_normal(n)
+def _power_iteration(apply: Callable[[np.ndarray], np.ndarray], start: np.ndarray, iterations: int = 60,
+                     dot: Callable[[np.ndarray, np.ndarray], float] | None = None) -> float:
+    """Largest eigenvalue of a symmetric-positive operator (in its mass metric) by power iteration
+    from ``start``; ``dot`` sums over the ranks' owned entries on MPI ranks."""
+    w = start
     lam = 0.0
     for _ in range(iterations):
         z = apply(w)
-        norm = np.linalg.norm(z)
+        norm = np.linalg.norm(z) if dot is None else np.sqrt(dot(z, z))
         if norm == 0.0:
             return 0.0
-        lam = float(w @ z / (w @ w))
+        lam = float(w @ z / (w @ w)) if dot is None else dot(w, z) / dot(w, w)
         w = z / norm
     return lam
 
 
-def stable_steps(model: ExplicitUPModel, safety: float = 1.0) -> dict[str, float]:
+def _summed(share) -> Callable[[np.ndarray], np.ndarray]:
+    """A rank's contributions over its local unknowns to the whole model's values there
+    (``UnknownShare.assemble``, collective); serially the values themselves."""
+    return (lambda v: v) if share is None else share.assemble
+
+
+def stable_steps(model: ExplicitUPModel, safety: float = 1.0, seed: int = 0) -> dict[str, float]:
     """Stable-step estimates [s]: ``wave`` = 2 / omega_max of the undrained skeleton,
     ``diffusion`` = 2 / lambda_max of M_p^-1 H, each times ``safety``; ``governs`` names the
     smaller. ``coupled`` = 1 / (1/wave + 1/diffusion) is the step the stepper allows: where both
     limits are close the coupled scheme's limit falls below the smaller (to 0.62 of it on the
     one-node systems of ``tests/test_explicit_up.py``, where ``coupled`` is 0.50-0.91 of it).
     Power iteration approaches the largest eigenvalues from below, so the estimates can be a few
-    percent long: run at a fraction of ``coupled`` (e.g. 0.9, as ``safety`` or on dt)."""
+    percent long: run at a fraction of ``coupled`` (e.g. 0.9, as ``safety`` or on dt).
+
+    A model split over MPI ranks (``share``, ``local``) starts from the serial run's vectors
+    (seeded over the whole model's unknowns) and sums its products over the owned entries, so
+    every rank gets the serial estimates to round-off. Collective then."""
     lay = model.layout
     su, sp_ = lay.block("u"), lay.block("p")
-    m = model.lumped_mass()
+    share = getattr(model, "share", None)
+    total = _summed(share)
+    m = total(np.asarray(model.lumped_mass(), float))
     mu, mp = m[su], m[sp_]
     nu, npr = mu.size, mp.size
     zero_p, zero_u = np.zeros(npr), np.zeros(nu)
+    if share is None:
+        start_u, start_p = (np.random.default_rng(seed).standard_normal(k) for k in (nu, npr))
+        dot_u = dot_p = None
+    else:
+        owned = np.zeros(lay.size, bool)
+        owned[share.owned] = True
+        index = np.asarray(model.local.index)
+        whole_u = int(round(share.total(np.count_nonzero(owned[su]))))
+        whole_p = int(round(share.total(np.count_nonzero(owned[sp_]))))
+        start_u = np.random.default_rng(seed).standard_normal(whole_u)[index[su]]
+        start_p = np.random.default_rng(seed).standard_normal(whole_p)[index[sp_] - whole_u]
+        dot_u = lambda a, b: share.total(float(a[owned[su]] @ b[owned[su]]))  # noqa: E731
+        dot_p = lambda a, b: share.total(float(a[owned[sp_]] @ b[owned[sp_]]))  # noqa: E731
+
+    def block(values: np.ndarray, at: slice) -> np.ndarray:
+        if share is None:
+            return values
+        whole = np.zeros(lay.size)
+        whole[at] = values
+        return total(whole)[at]
+
     # Undrained (the fast wave): no flow, so M_p p' = -C_pu u' gives p = -M_p^-1 f_p(u, 0) and the
     # skeleton sees K + C_up M_p^-1 C_pu.
-    omega2 = _power_iteration(lambda w: model.solid_force(w, -model.fluid_flux(w, zero_p) / mp) / mu, nu)
+    omega2 = _power_iteration(lambda w: block(model.solid_force(w, -block(model.fluid_flux(w, zero_p), sp_) / mp), su)
+                              / mu, start_u, dot=dot_u)
     # The flux's response to p alone: f_p(0, p) = H p (+ the stabilization, which is part of it).
-    lam = _power_iteration(lambda w: model.fluid_flux(zero_u, w) / mp, npr)
+    lam = _power_iteration(lambda w: block(model.fluid_flux(zero_u, w), sp_) / mp, start_p, dot=dot_p)
     wave = safety * 2.0 / np.sqrt(omega2) if omega2 > 0 else np.inf
     diffusion = safety * 2.0 / lam if lam > 0 else np.inf
     return {"wave": wave, "diffusion": diffusion, "coupled": 1.0 / (1.0 / wave + 1.0 / diffusion),
@@ -182,10 +217,18 @@ class ExplicitUP:
         at t = 0 and every ``record_every`` steps.
 
         ``checkpoint_every`` steps (and at the last) the state and the samples so far go to
-        ``checkpoint_dir`` (written by rank 0 of ``comm``); ``resume``, a folder holding such a
-        checkpoint of the same model and dt, continues from it to the same result as an
-        uninterrupted run (the acceleration is a function of the state, so x and the rates
-        are the whole state)."""
+        ``checkpoint_dir`` (written by rank 0 of ``comm``, or one file per rank for a model split
+        over the ranks); ``resume``, a folder holding such a checkpoint of the same model and
+        dt, continues from it to the same result as an uninterrupted run (the acceleration is a
+        function of the state, so x and the rates are the whole state).
+
+        A model split over MPI ranks (``share``: its masses, forces and fluxes are its points'
+        contributions over its local unknowns) is stepped on the local vectors: every force is
+        summed over the ranks (one neighbour exchange), so each local entry, owned or ghost,
+        takes the whole model's update; the essential conditions' rows are whole on every rank
+        (over its local unknowns), which projects alike; the new values and rates of the ghosts
+        are then copied from their owners. ``record`` sees the local vectors (sum its owned
+        terms over the ranks)."""
         if checkpoint_every and checkpoint_dir is None:
             raise InputError("checkpoint_every needs checkpoint_dir")
         lay = model.layout
@@ -193,8 +236,13 @@ class ExplicitUP:
             raise InputError("ExplicitUP needs a displacement field 'u' of time order 2 and a pressure 'p' of order 1")
         su, sp_ = lay.block("u"), lay.block("p")
         n = lay.size
+        share = getattr(model, "share", None)
+        total = _summed(share)
+        files = RankFiles(share, comm)
         mass = np.asarray(model.lumped_mass(), float)
-        if mass.shape != (n,) or not np.all(mass > 0):
+        mass = total(mass) if mass.shape == (n,) else mass
+        bad = mass.shape != (n,) or not np.all(mass > 0)
+        if share.max(float(bad)) if share is not None else bad:
             raise InputError("lumped_mass() must give a positive mass for each of the model's unknowns")
         limits = {}
         if self.check_stability:
@@ -213,13 +261,28 @@ class ExplicitUP:
 
         def f_ext(t):
             f = model.external_force(t)
-            return np.zeros(n) if f is None else np.asarray(f, float)
+            return np.zeros(n) if f is None else np.array(f, float)  # a copy: the step adds to it
 
         def acceleration(x, t):
             """a from (6.42) at the new u and p."""
+            r = f_ext(t)
+            r[su] -= model.solid_force(x[su], x[sp_])
+            r[sp_] = 0.0
             a = np.zeros(n)
-            a[su] = (f_ext(t)[su] - model.solid_force(x[su], x[sp_])) / mass[su]
+            a[su] = total(r)[su] / mass[su]
             return a
+
+        def storage_rate(x_new, x, t):
+            """p' over the step from (6.43): the coupling by the step's displacement increment
+            (the rate at the half step), the diffusion at p_n (theta = 0)."""
+            r = f_ext(t - 0.5 * dt)
+            r[sp_] -= model.fluid_flux((x_new[su] - x[su]) / dt, x[sp_])
+            r[su] = 0.0
+            return total(r)[sp_] / mass[sp_]
+
+        def from_owners(w):
+            """w with its ghost entries copied from their owners (on ranks)."""
+            return w if share is None else share.spread(np.ascontiguousarray(w))
 
         def constrain(w, block, proj, target):
             if proj.G is not None:
@@ -228,8 +291,8 @@ class ExplicitUP:
 
         times, samples = [], []
         first, resumed_from = 1, None
-        if resume is not None and has_checkpoint(resume):
-            ck = load_arrays(resume)
+        if resume is not None and has_checkpoint(resume):  # per rank: refused on another number of ranks
+            ck = files.load(resume)
             if ck["x"].shape != (n,) or float(ck["dt"]) != dt:
                 raise InputError(f"the checkpoint in {str(resume)!r} has {ck['x'].size} unknowns and dt = "
                                  f"{float(ck['dt']):.6g} s, this run {n} and {dt:.6g} s: resume the same run, or "
@@ -244,9 +307,9 @@ class ExplicitUP:
             samples.append(np.asarray(record(x, rate, 0.0)))
 
         def save(step):
-            save_arrays(checkpoint_dir, {"x": x, "rate": rate, "step": np.int64(step), "dt": np.float64(dt),
-                                         "times": np.asarray(times, float), "samples": np.asarray(samples)},
-                        comm=comm)
+            save_arrays(files.folder(checkpoint_dir), {"x": x, "rate": rate, "step": np.int64(step),
+                                                       "dt": np.float64(dt), "times": np.asarray(times, float),
+                                                       "samples": np.asarray(samples)}, comm=files.writer)
 
         acc = acceleration(x, (first - 1) * dt)
         for step in range(first, num_steps + 1):
@@ -254,18 +317,18 @@ class ExplicitUP:
             x_new = x.copy()
             x_new[su] += dt * rate[su] + 0.5 * dt * dt * acc[su]
             constrain(x_new, su, proj_u, lambda part: proj_u.displacement_target(part, t))
-            # The storage equation over the step, with the coupling by the step's displacement
-            # increment (the rate at the half step) and the diffusion at p_n (theta = 0).
-            v_half = (x_new[su] - x[su]) / dt
-            rate[sp_] = (f_ext(t - 0.5 * dt)[sp_] - model.fluid_flux(v_half, x[sp_])) / mass[sp_]
+            rate[sp_] = storage_rate(x_new, x, t)
             x_new[sp_] += dt * rate[sp_]
             constrain(x_new, sp_, proj_p, lambda part: proj_p.displacement_target(part, t))
-            if not np.all(np.isfinite(x_new)):
+            finite = np.all(np.isfinite(x_new))
+            if not (share.least(int(finite)) if share is not None else finite):
                 raise InputError(f"step {step} (t = {t:.4g} s): the solution is no longer finite; "
                                  "the step is unstable, take a smaller dt")
+            x_new = from_owners(x_new)
             acc_new = acceleration(x_new, t)
             rate[su] += 0.5 * dt * (acc[su] + acc_new[su])
             constrain(rate, su, proj_u, lambda part: proj_u.velocity_target(t, dt))
+            rate = from_owners(rate)
             acc, x = acc_new, x_new
             if record is not None and step % record_every == 0:
                 times.append(t)

@@ -10,7 +10,7 @@ POINT is where the process dies:
                       before the new one replaces checkpoint.npz;
     mid-result        half-way through writing a finished run's result.npz (N-th run);
     never             run to the end.
-CASE is ``kalthoff`` (default), ``mandel`` or ``liakopoulos``; under mpiexec every rank dies at its own N-th
+CASE is ``kalthoff`` (default), ``mandel``, ``liakopoulos`` or ``wave_column``; under mpiexec every rank dies at its own N-th
 checkpoint (one file per rank).
 """
 import importlib
@@ -27,7 +27,8 @@ ARGS = ["--method", "rkpm", "--set", "h=2.564e-3", "unregularized_h=2.564e-3", "
         "t_end=2e-5", "--checkpoint-every", "20"]
 MANDEL_ARGS = ["--quick", "--method", "rkpm", "--checkpoint-every", "4"]
 LIAKOPOULOS_ARGS = ["--quick", "--method", "rkpm", "--checkpoint-every", "30"]
-CASE_ARGS = {"kalthoff": ARGS, "mandel": MANDEL_ARGS, "liakopoulos": LIAKOPOULOS_ARGS}
+WAVE_COLUMN_ARGS = ["--quick", "--method", "rkpm", "--checkpoint-every", "200"]
+CASE_ARGS = {"kalthoff": ARGS, "mandel": MANDEL_ARGS, "liakopoulos": LIAKOPOULOS_ARGS, "wave_column": WAVE_COLUMN_ARGS}
 
 
 def die():
