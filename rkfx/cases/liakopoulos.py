@@ -324,7 +324,8 @@ def plot(results: Results, out: Path) -> list[Path]:
             a_hist.plot(t, 1e-3 * np.asarray(s["probes"])[:, j], color=f"C{j}", **style,
                         label=f"{r.method}, y = {y:g} m")
         a_set.plot(t, 1e3 * np.asarray(s["settlement"]), color="k" if is_fem else "C3", **style, label=r.method)
-    if fem is not None:
+    compared = fem is not None and any(r is not fem for r in results.runs)
+    if compared:
         ref = np.asarray(fem.series["profiles"])
         for r in results.runs:
             if r is fem:
@@ -344,6 +345,10 @@ def plot(results: Results, out: Path) -> list[Path]:
         a_diff.set_xlabel("p_RKPM - p_FEM [Pa]")
         a_diff.set_ylabel("height y [m]")
         a_diff.legend(fontsize=8)
+    else:  # one method only: nothing to difference
+        a_diff.text(0.5, 0.5, "RKPM - FEM: both methods are needed\n(--method both)", ha="center", va="center",
+                    fontsize=11, color="0.4", transform=a_diff.transAxes)
+        a_diff.set_axis_off()
     a_prof.set_xlabel("water pressure p [kPa]")
     a_prof.set_ylabel("height y [m]")
     a_prof.set_title("profiles on the axis (thin RKPM, broad dashed FEM)", fontsize=9)
@@ -355,7 +360,7 @@ def plot(results: Results, out: Path) -> list[Path]:
     a_set.set_xlabel("t [min]")
     a_set.set_ylabel("settlement of the top [mm]")
     a_set.legend(fontsize=8)
-    for ax in axes.ravel():
+    for ax in (a_prof, a_hist, a_set) + ((a_diff,) if compared else ()):
         ax.grid(alpha=0.3)
     fig.suptitle(f"Liakopoulos drainage column, {prm['ny']} nodes along the height ({prm['retention']} retention)")
     return [_cli.save(fig, out / "drainage.png")]
