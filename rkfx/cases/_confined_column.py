@@ -10,6 +10,7 @@ q from t = 0.
 On a communicator of several ranks the nodes are split by RCB: each rank's rule covers its own
 nodes' cells only, and ``column_unknowns`` gives its local unknowns (own nodes, then ghosts).
 """
+from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
@@ -84,15 +85,14 @@ class ConfinedColumn(NamedTuple):
         model: The explicit u-p model (on MPI ranks the rank's part, ``model.share``).
         top: A node on the top (index).
         base: A node on the base (index).
-        probe: Rows over the model's vector giving [u_y^h, p^h] on the axis at the top and at
-            the base: ``probe @ x`` = [u_y(W/2, L), p(W/2, 0)]; on ranks over the rank's local
-            vector with its owned unknowns' terms only (their sum over the ranks is the value).
+        observe: [u_y(W/2, L), p(W/2, 0)] = u_y^h on the axis at the top and p^h at the base,
+            of the model's vector (on MPI ranks of the rank's local vector, collective).
     """
 
     model: ExplicitPoroDynamics
     top: int
     base: int
-    probe: sp.csr_matrix
+    observe: Callable[[np.ndarray], np.ndarray]
 
 
 def confined_column(ny: int, rule: str = "nsni", medium: Constituents = SOARES, height: float = 10.0,
@@ -129,9 +129,6 @@ def confined_column(ny: int, rule: str = "nsni", medium: Constituents = SOARES, 
     if d.own is not None:
         local = column_unknowns(d, sp.vstack(rows), comm)
         rows = [g[:, local.index].tocsr() for g in rows]
-        owned = np.zeros(len(local.index), bool)
-        owned[local.share.owned] = True
-        probe = (probe[:, local.index] @ sp.diags(owned.astype(float))).tocsr()
     essential = [Constraint(g) for g in rows]
     return ConfinedColumn(ExplicitPoroDynamics(r, medium, essential, load=lambda t: f, local=local), int(top[0]),
-                          int(bottom[0]), probe)
+                          int(bottom[0]), probe.__matmul__ if local is None else local.observer(probe))

@@ -64,6 +64,7 @@ import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 from rkfx.approximation.semi_lagrangian import evaluate_moving
+from rkfx.assembly.weighted_forms import placed
 from rkfx.cases import _cli, _preflight
 from rkfx.cases._cli import Param, Results, Run
 from rkfx.cases._confined_column import column_discretization, column_unknowns
@@ -188,19 +189,15 @@ def _rkpm(soil, W, L, ny, rule, times, points, io):
                    collocation_rows(d.rk, own(d.bottom), None, n, 2 * n, size)]).tocsr()
     nearest = cKDTree(d.particles.x).query(points)[1]
     rows = evaluate_moving(d.rk, points, nearest).matrix().tocsr()
+    # [p at the points..., u_y at the last one] over the whole vector
+    rows = sp.vstack([placed(rows[:-1], size, 2 * n), placed(rows[-1:], size, 1, 2)]).tocsr()
     local = None
     if ranks:
         local = column_unknowns(d, G, comm)
         G = G[:, local.index].tocsr()
-        nl, no = len(local.nodes), local.num_owned_nodes
-        owned = local.nodes[:no]
-        rows_own = rows[:, owned].tocsr()
-
-        def sample(x):  # the owned nodes' terms, summed over the ranks
-            return comm.allreduce(np.r_[rows_own[:-1] @ x[2 * nl:2 * nl + no], rows_own[-1] @ x[1:2 * no:2]])
+        sample = local.observer(rows)
     else:
-        def sample(x):
-            return np.r_[rows[:-1] @ x[2 * n:], rows[-1] @ x[1:2 * n:2]]
+        sample = rows.__matmul__
     model = UnsaturatedBiotModel(d.rule, soil, Constraints(G, np.zeros(G.shape[0])), local)
 
     rec = _Samples(sample)

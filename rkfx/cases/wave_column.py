@@ -146,15 +146,13 @@ def _rkpm(medium, L, q, ny, rule, t_end, courant, samples, io):
     """The RKPM history: times, u_y(L), p(0), and what the run measured."""
     t0 = time.perf_counter()
     comm = _cli.comm()
-    model, _, _, probe = confined_column(ny, rule, medium, L, q, comm=comm)
+    model, _, _, observe = confined_column(ny, rule, medium, L, q, comm=comm)
     limits = stable_steps(model)
-    # On ranks the probe holds each rank's owned terms: their sum is the value.
-    total = (lambda v: v) if model.share is None else (lambda v: comm.allreduce(v))
     steps = int(np.ceil(t_end / (courant * limits["coupled"])))
     dt = t_end / steps
     bar = _cli.step_progress(f"rkpm-{rule} ny={ny}", steps)
     try:
-        run = ExplicitUP(dt, check_stability=False).run(model, steps, record=lambda x, r, t: total(probe @ x),
+        run = ExplicitUP(dt, check_stability=False).run(model, steps, record=lambda x, r, t: observe(x),
                                                         record_every=max(1, steps // samples), progress=bar,
                                                         comm=comm, **io)
     finally:

@@ -7,10 +7,11 @@ tracking, the admissions of the step's iterates in ``_trial_tracking`` (``(allow
 protocol (``rkfx.solvers.model``): the RKPM hydraulic-fracture model and its crack-band FEM
 baseline share it. The model holds ``committed`` (a ``DamageState``), ``points`` (its
 ``DamageModel``), ``residual_fraction`` (the least 1 - D), ``allowed`` (or ``None`` without
-tracking), ``parent``, ``iterations`` (Newton iterations of every accepted step), ``_count`` (those of the step under way) and ``track`` (a
-``rkfx.fracture.tracking.Tracking``, or ``None``). A model with a pre-existing fracture sets
-``fracture`` (a ``rkfx.fracture.contact.FractureContact``, whose slip is history too): it is
-committed, saved and restored with the damage.
+tracking), ``parent``, ``iterations`` (Newton iterations of every accepted step), ``_count``
+(those of the step under way) and ``track`` (a ``rkfx.fracture.tracking.Tracking``, or
+``None``). A model with a pre-existing fracture sets ``fracture`` (a
+``rkfx.fracture.contact.FractureContact``, whose slip is history too): it is committed, saved and
+restored with the damage.
 
 Damage updates (``damage_update``, set by the model):
 

@@ -284,7 +284,8 @@ def nodal_integration(rk: MovingRK, cells: NodalCells, boundary: BoundaryRule | 
             zeta = vc_correction(trial, cells.volume, gamma, boundary)
         else:
             around = _reaching(rk, cells, trial.indices)
-            zeta = vc_correction(_gradient_rows(rk, cells, smoothed, around)[1], cells.volume[around], gamma, boundary)
+            ring = _gradient_rows(rk, cells, smoothed, around, values=False)[1]
+            zeta = vc_correction(ring, cells.volume[around], gamma, boundary)
         test = corrected(trial, zeta)
     moments = trial_x = trial_y = None
     if stabilized:
@@ -294,13 +295,14 @@ def nodal_integration(rk: MovingRK, cells: NodalCells, boundary: BoundaryRule | 
     return NodalIntegration(weights, values, trial, test, moments, trial_x, trial_y, rule)
 
 
-def _gradient_rows(rk: MovingRK, cells: NodalCells, smoothed: bool,
-                   nodes: np.ndarray | None) -> tuple[SparseRows, SparseRows]:
-    """Value rows at the nodes and trial gradient rows (smoothed or direct) of their cells, at
-    ``nodes`` (every node when ``None``)."""
+def _gradient_rows(rk: MovingRK, cells: NodalCells, smoothed: bool, nodes: np.ndarray | None,
+                   values: bool = True) -> tuple[SparseRows | None, SparseRows]:
+    """Value rows at the nodes (``None`` unless ``values``; the direct gradients bring them
+    anyway) and trial gradient rows (smoothed or direct) of their cells, at ``nodes`` (every
+    node when ``None``)."""
     at = () if nodes is None else (rk.x[nodes], nodes)
     if smoothed:
-        return evaluate_moving(rk, *at), smoothed_gradients(rk, cells, nodes)
+        return evaluate_moving(rk, *at) if values else None, smoothed_gradients(rk, cells, nodes)
     rows = evaluate_moving(rk, *at, gradients=True)
     return rows.component(0), SparseRows(rows.indptr, rows.indices, np.ascontiguousarray(rows.data[:, 1:]),
                                          rows.num_cols)

@@ -205,6 +205,15 @@ class LocalUnknowns:
         """The local rows and columns of a whole model's matrix (a rank's contribution)."""
         return sp.csr_matrix(whole)[self.index][:, self.index]
 
+    def observer(self, rows: sp.spmatrix):
+        """``rows`` over a whole model's vector (samples, probes) as a function of the local
+        vector: each rank's owned terms, summed over the ranks (collective; every rank gets
+        the values)."""
+        owned = np.zeros(len(self.index))
+        owned[self.share.owned] = 1.0
+        mine = (sp.csr_matrix(rows)[:, self.index] @ sp.diags(owned)).tocsr()
+        return lambda x: self.share.comm.allreduce(mine @ x)
+
 
 def touched_nodes(components: tuple[int, ...], num_nodes: int, *matrices: sp.spmatrix) -> np.ndarray:
     """The nodes whose unknowns (fields of ``components`` values per node, one block after
