@@ -68,3 +68,23 @@ def divergence(rule: NodalIntegration, alpha: float) -> sp.csr_matrix:
 def lumped(rule: NodalIntegration, c: float = 1.0) -> np.ndarray:
     """Row-sum lumped mass ``sum_L V_L c N_I(x_L)`` per node, shape ``(n,)``."""
     return c * (rule.values.matrix().T @ rule.weights)
+
+
+def pressure_projection(rule: NodalIntegration, eps_f) -> sp.csr_matrix:
+    """The fluid pressure projection ``int eps_f (N_I - Pi N_I)(N_J - Pi N_J)`` of (6.49) on the
+    rule's cells, shape ``(n, n)`` [m^3/Pa]; ``eps_f``: a scalar or one value per point [1/Pa].
+
+    Pi is the mean over a node's cell. With N expanded about x_L as in (6.52), N - Pi N =
+    (x - x_L) . grad N (the cell's first moments vanish, 6.58), so the cell's term is
+    ``m_Lx N_I,x N_J,x + m_Ly N_I,y N_J,y`` with the trial gradients at x_L: symmetric, positive
+    semi-definite, zero on constants. The moments are the rule's; a rule without them (DNI,
+    SNNI) takes those of a square cell of its weight, m = V_L^2 / 12.
+    """
+    w = rule.weights
+    m = np.column_stack([w * w / 12.0] * 2) if rule.moments is None else rule.moments
+    eps = np.broadcast_to(np.asarray(eps_f, dtype=float), w.shape)
+    form = sp.csr_matrix((rule.values.num_cols,) * 2)
+    for j in range(2):
+        b = rule.trial.matrix(j)
+        form = form + b.T @ sp.diags(eps * m[:, j]) @ b
+    return form.tocsr()

@@ -96,7 +96,7 @@ class ConfinedColumn(NamedTuple):
 
 
 def confined_column(ny: int, rule: str = "nsni", medium: Constituents = SOARES, height: float = 10.0,
-                    load: float = 3000.0, comm=None) -> ConfinedColumn:
+                    load: float = 3000.0, comm=None, fpp: bool = False) -> ConfinedColumn:
     """The model of a column of ``ny`` nodes along y, two of its nodes and its probe.
 
     Args:
@@ -108,6 +108,7 @@ def confined_column(ny: int, rule: str = "nsni", medium: Constituents = SOARES, 
         comm: On a communicator of several ranks the model is split over them (RCB): each rank
             integrates over its own nodes' cells and keeps the rows of every essential
             condition over its local unknowns (the columns of the conditions are its ghosts).
+        fpp: Stabilize the storage rows by the fluid pressure projection (``ExplicitPoroDynamics``).
     """
     h = height / (ny - 1)
     d = column_discretization(2 * h, height, 3, ny, rule, comm=comm)
@@ -130,5 +131,5 @@ def confined_column(ny: int, rule: str = "nsni", medium: Constituents = SOARES, 
         local = column_unknowns(d, sp.vstack(rows), comm)
         rows = [g[:, local.index].tocsr() for g in rows]
     essential = [Constraint(g) for g in rows]
-    return ConfinedColumn(ExplicitPoroDynamics(r, medium, essential, load=lambda t: f, local=local), int(top[0]),
+    return ConfinedColumn(ExplicitPoroDynamics(r, medium, essential, load=lambda t: f, local=local, fpp=fpp), int(top[0]),
                           int(bottom[0]), probe.__matmul__ if local is None else local.observer(probe))

@@ -35,9 +35,13 @@ rings). Studies:
 * rules — NSNI and DNI at ``ny`` nodes along the height (Fig 6.5), and Taylor-Hood;
 * refinement — NSNI at ``refine_ny`` nodes (Fig 6.6): errors and observed rates.
 
+With ``fpp=true`` the RKPM storage rows carry the fluid pressure projection of (6.49) on the
+pressure rates (``rkfx.models.explicit_poroelasticity``); off by default: on this column it
+smears the fronts (docs/large_deformation.md).
+
 Parameters and units (``--set NAME=VALUE``): E [Pa], nu [-], rho_s, rho_f [kg/m^3], porosity [-],
 k [m^4/(N s)], K_s, K_f [Pa], L [m], q [Pa], ny [count], refine_ny (list), rules (list),
-t_end [s], courant [-], fem_courant [-], exclude [s], samples [count].
+t_end [s], courant [-], fem_courant [-], exclude [s], samples [count], fpp [bool].
 
     python -m rkfx.cases.wave_column [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
         [--checkpoint-every N] [--resume DIR]
@@ -86,6 +90,7 @@ PARAMS = {
     "fem_courant": Param(0.5, "FEM step / (h / c_fast) [-]"),
     "exclude": Param(1.0e-3, "time left out either side of a front's arrival [s]"),
     "samples": Param(2000, "recorded samples per history, at most [count]"),
+    "fpp": Param(False, "RKPM storage rows stabilized by the fluid pressure projection (6.49) [bool]"),
 }
 QUICK = {"ny": 121, "refine_ny": [61, 121]}
 
@@ -100,7 +105,7 @@ def _exact(medium: Constituents, L: float, q: float) -> WaveColumn:
 
 
 def check(*, E, nu, rho_s, rho_f, porosity, k, K_s, K_f, L, q, ny, refine_ny, rules, t_end, courant, fem_courant,
-          exclude, samples, **_) -> None:
+          exclude, samples, fpp=False, **_) -> None:
     """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
     _medium(E, nu, rho_s, rho_f, porosity, k, K_s, K_f)
     for name, v in (("L", L), ("t_end", t_end), ("fem_courant", fem_courant)):
@@ -120,6 +125,8 @@ def check(*, E, nu, rho_s, rho_f, porosity, k, K_s, K_f, L, q, ny, refine_ny, ru
         raise InputError(f"exclude = {exclude!r} s must lie in [0, t_end / 4)")
     if int(samples) != samples or samples < 10:
         raise InputError(f"samples = {samples!r}: record at least 10 samples")
+    if not isinstance(fpp, (bool, np.bool_)):
+        raise InputError(f"fpp = {fpp!r} must be true or false")
 
 
 def memory_need(methods, *, ny, refine_ny, **_) -> _preflight.Need:
@@ -142,11 +149,11 @@ def _errors(exact: WaveColumn, t: np.ndarray, u: np.ndarray, p: np.ndarray, excl
     return errors, u_exact[:, 0], p_exact[:, 1]
 
 
-def _rkpm(medium, L, q, ny, rule, t_end, courant, samples, io):
+def _rkpm(medium, L, q, ny, rule, t_end, courant, samples, io, fpp=False):
     """The RKPM history: times, u_y(L), p(0), and what the run measured."""
     t0 = time.perf_counter()
     comm = _cli.comm()
-    model, _, _, observe = confined_column(ny, rule, medium, L, q, comm=comm)
+    model, _, _, observe = confined_column(ny, rule, medium, L, q, comm=comm, fpp=fpp)
     limits = stable_steps(model)
     steps = int(np.ceil(t_end / (courant * limits["coupled"])))
     dt = t_end / steps
@@ -187,18 +194,18 @@ def _fem(medium, L, q, ny, t_end, fem_courant, c_fast, samples, io):
 
 def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=254423076.9, nu=0.298, rho_s=2700.0, rho_f=1000.0,
         porosity=0.48, k=3.55e-9, K_s=1.1e10, K_f=3.3e9, L=10.0, q=3000.0, ny=241, refine_ny=(61, 121, 241, 481),
-        rules=("nsni", "dni"), t_end=0.05, courant=0.9, fem_courant=0.5, exclude=1.0e-3, samples=2000,
+        rules=("nsni", "dni"), t_end=0.05, courant=0.9, fem_courant=0.5, exclude=1.0e-3, samples=2000, fpp=False,
         checkpoint_every=0, work_dir=None, resume=None) -> Results:
     """Both studies for every requested method; see the module docstring."""
     check(E=E, nu=nu, rho_s=rho_s, rho_f=rho_f, porosity=porosity, k=k, K_s=K_s, K_f=K_f, L=L, q=q, ny=ny,
           refine_ny=refine_ny, rules=rules, t_end=t_end, courant=courant, fem_courant=fem_courant, exclude=exclude,
-          samples=samples)
+          samples=samples, fpp=fpp)
     medium = _medium(E, nu, rho_s, rho_f, porosity, k, K_s, K_f)
     exact = _exact(medium, L, q)
     ck = _cli.Checkpoints(checkpoint_every, work_dir, resume)
     results = Results(NAME, dict(E=E, nu=nu, rho_s=rho_s, rho_f=rho_f, porosity=porosity, k=k, K_s=K_s, K_f=K_f, L=L,
                                  q=q, ny=ny, refine_ny=list(refine_ny), rules=list(rules), t_end=t_end,
-                                 courant=courant, fem_courant=fem_courant, exclude=exclude,
+                                 courant=courant, fem_courant=fem_courant, exclude=exclude, fpp=fpp,
                                  fast_speed=exact.fast_speed, undrained_pressure=exact.undrained_pressure,
                                  drained_settlement=exact.drained_settlement, c_v=exact.c_v))
 
@@ -219,7 +226,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=254423076.9, nu=0.298, rh
             if rule is None:
                 out = _fem(medium, L, q, n, t_end, fem_courant, exact.fast_speed, samples, ck.for_run(label))
             else:
-                out = _rkpm(medium, L, q, n, rule, t_end, courant, samples, ck.for_run(label))
+                out = _rkpm(medium, L, q, n, rule, t_end, courant, samples, ck.for_run(label), fpp)
         record(label, study, n, *out)
     refined = sorted((r for r in results.runs if r.info["study"] == "refinement"), key=lambda r: r.info["ny"])
     for coarse, fine in zip(refined, refined[1:]):

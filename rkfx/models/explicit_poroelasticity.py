@@ -9,6 +9,12 @@ row sums, and the two halves of the internal force that ``rkfx.solvers.explicit_
 
 with the storage 1/Q in M_p and the density rho = (1 - n) rho_s + n rho_f in M_u. Essential
 conditions are collocation rows at boundary nodes (the shape functions do not interpolate).
+
+With ``fpp=True`` the storage rows carry the fluid pressure projection of (6.49) on the rates,
+eps_f int (psi - Pi psi)(p' - Pi p'), the stabilization of chapter 3 for equal-order u-p in
+the nearly undrained limit: ``pressure_stabilization(dt)`` gives its matrix S
+(``nodal_forms.pressure_projection``, eps_f of (3.53) with h = sqrt(V_L)), which the stepper
+adds to the lumped storage (M_p + S) p' = r. S has zero row sums, so lumping would erase it.
 """
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -20,7 +26,7 @@ from rkfx.approximation.semi_lagrangian import MovingRK, evaluate_moving
 from rkfx.assembly import nodal_forms
 from rkfx.errors import InputError
 from rkfx.integration.nodal_stabilized import NodalIntegration
-from rkfx.models.poroelasticity import PoroMaterial
+from rkfx.models.poroelasticity import PoroMaterial, fpp_parameter
 from rkfx.parallel.unknowns import LocalUnknowns
 from rkfx.solvers.central_difference import Constraint
 from rkfx.solvers.fields import layout
@@ -100,11 +106,13 @@ class ExplicitPoroDynamics:
             stepper, which adds them up), and ``essential`` holds every condition's rows over
             the local unknowns (the rank's local nodes cover their columns). ``None``: the
             whole model.
+        fpp: Stabilize the storage rows by the fluid pressure projection (see the module).
     """
 
     def __init__(self, rule: NodalIntegration, medium: Constituents, essential: Sequence[Constraint] = (),
-                 load=None, local: LocalUnknowns | None = None):
+                 load=None, local: LocalUnknowns | None = None, fpp: bool = False):
         self.local = local
+        self.fpp = bool(fpp)
         self.share = None if local is None else local.share
         if local is not None:
             rule = rule.localized(local.nodes)
@@ -133,6 +141,14 @@ class ExplicitPoroDynamics:
 
     def lumped_mass(self) -> np.ndarray:
         return self._mass
+
+    def pressure_stabilization(self, dt: float) -> sp.csr_matrix | None:
+        """S of the fluid pressure projection for the step ``dt`` [s] over the p unknowns, or
+        ``None`` without it (on ranks: the rank's points' part)."""
+        if not self.fpp:
+            return None
+        eps_f = fpp_parameter(self.medium.material, dt, np.sqrt(self.rule.weights))
+        return nodal_forms.pressure_projection(self.rule, eps_f)
 
     def solid_force(self, u: np.ndarray, p: np.ndarray) -> np.ndarray:
         return self.K @ u - self.C_up @ p

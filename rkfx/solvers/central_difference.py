@@ -403,9 +403,12 @@ class ExplicitResult:
 
 
 class _Projection:
-    """M-orthogonal projection onto {G w = target}, G M^-1 G^T factorized once."""
+    """M-orthogonal projection onto {G w = target}, G M^-1 G^T factorized once. ``inverse``:
+    z = M^-1 b for a mass M other than diag(``mass``) (e.g. a consistent capacity), which then
+    gives the metric."""
 
-    def __init__(self, constraints: Sequence[Constraint], mass: np.ndarray):
+    def __init__(self, constraints: Sequence[Constraint], mass: np.ndarray,
+                 inverse: Callable[[np.ndarray], np.ndarray] | None = None):
         self.parts = list(constraints)
         self.G = sp.vstack([c.G for c in self.parts]).tocsr() if self.parts else None
         if self.G is None or self.G.shape[0] == 0:
@@ -414,7 +417,11 @@ class _Projection:
         if self.G.shape[1] != len(mass):
             raise InputError(f"constraint rows have {self.G.shape[1]} columns for {len(mass)} unknowns")
         self.GT = self.G.T.tocsr()
-        self.minv_gt = sp.diags(1.0 / mass) @ self.GT
+        if inverse is None:
+            self.minv_gt = sp.diags(1.0 / mass) @ self.GT
+        else:
+            self.minv_gt = sp.csr_matrix(np.column_stack([inverse(self.GT[:, [i]].toarray().ravel())
+                                                          for i in range(self.GT.shape[1])]))
         try:
             self.lu = linear_solver(self.G @ self.minv_gt, solver="serial")
             singular = not self.lu.pivot_ratio() > 1e-12

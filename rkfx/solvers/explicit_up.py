@@ -174,6 +174,33 @@ def stable_steps(model: ExplicitUPModel, safety: float = 1.0, seed: int = 0) -> 
             "governs": "wave" if wave <= diffusion else "diffusion"}
 
 
+def _capacity_solver(S, mp: np.ndarray, summed_p: Callable[[np.ndarray], np.ndarray],
+                     dot: Callable[[np.ndarray, np.ndarray], float], tol: float = 1e-10, max_iterations: int = 2000
+                     ) -> Callable[[np.ndarray], np.ndarray]:
+    """z = (M_p + S)^-1 b by conjugate gradients preconditioned by the lumped M_p (S: a model's
+    pressure stabilization, on ranks its points' part, summed by ``summed_p``), to a relative
+    residual ``tol`` in the M_p^-1 norm; refuses in one line when it does not converge."""
+    def solve(b):
+        z = b / mp
+        r, s = b.copy(), z.copy()
+        x = np.zeros_like(b)
+        rz = dot(r, s)
+        goal = tol * tol * rz
+        for _ in range(max_iterations):
+            if rz <= goal:
+                return x
+            q = mp * s + summed_p(S @ s)
+            step = rz / dot(s, q)
+            x += step * s
+            r -= step * q
+            z = r / mp
+            rz, rz_old = dot(r, z), rz
+            s = z + (rz / rz_old) * s
+        raise InputError(f"the storage rows with the pressure projection did not converge in {max_iterations} "
+                         "conjugate-gradient iterations: the projection's eps_f is far above 1/Q; run without fpp")
+    return solve
+
+
 def _by_field(constraints: Sequence[Constraint], su: slice, sp_: slice) -> tuple[list, list]:
     """The conditions on u and those on p, each with its rows restricted to its own block (the
     two masses differ by many orders of magnitude, so each field is projected in its own metric)."""
@@ -252,9 +279,28 @@ class ExplicitUP:
                 raise InputError(f"dt = {self.dt:.4g} s exceeds the stable step {bound:.4g} s (wave limit "
                                  f"{limits['wave']:.4g} s, diffusion limit {limits['diffusion']:.4g} s, the "
                                  f"{limits['governs']} governs): take a smaller dt")
-        proj_u, proj_p = (_Projection(part, mass[block]) for part, block in
-                          zip(_by_field(model.essential, su, sp_), (su, sp_)))
+        on_u, on_p = _by_field(model.essential, su, sp_)
+        proj_u = _Projection(on_u, mass[su])
         dt = self.dt
+        stabilization = getattr(model, "pressure_stabilization", None)
+        S = None if stabilization is None else stabilization(dt)
+        capacity = None
+        if S is not None:
+            owned_p = slice(None) if share is None else np.isin(np.arange(n), share.owned)[sp_]
+
+            def summed_p(v):
+                if share is None:
+                    return v
+                whole = np.zeros(n)
+                whole[sp_] = v
+                return total(whole)[sp_]
+
+            dot = (lambda a, b: float(a @ b)) if share is None else \
+                (lambda a, b: share.total(float(a[owned_p] @ b[owned_p])))
+            capacity = _capacity_solver(S, mass[sp_], summed_p, dot)
+        # With the projection the storage is M_p + S, and the pressure conditions are imposed in
+        # its metric, so that the rate stays the one of (M_p + S) p' = r on the free unknowns.
+        proj_p = _Projection(on_p, mass[sp_], capacity)
         x = np.zeros(n) if x0 is None else np.array(x0, float)
         rate = np.zeros(n)
         acc = np.zeros(n)  # only the u block is used
@@ -278,7 +324,8 @@ class ExplicitUP:
             r = f_ext(t - 0.5 * dt)
             r[sp_] -= model.fluid_flux((x_new[su] - x[su]) / dt, x[sp_])
             r[su] = 0.0
-            return total(r)[sp_] / mass[sp_]
+            b = total(r)[sp_]
+            return b / mass[sp_] if capacity is None else capacity(b)
 
         def from_owners(w):
             """w with its ghost entries copied from their owners (on ranks)."""
