@@ -34,6 +34,12 @@ e.g. collocation rows of u or p at boundary nodes) are imposed by M-orthogonal p
 new values and rates, as in ``CentralDifference``, each field in its own mass metric:
 G u_{n+1} = g(t_{n+1}), G u'_{n+1} = g'(t_{n+1}), G p_{n+1} = g(t_{n+1}).
 
+A model may also give ``pressure_stabilization(dt)``, a matrix S over the p unknowns (the fluid
+pressure projection of 6.49, zero row sums), or ``None``: the storage is then M_p + S, solved
+each step by conjugate gradients preconditioned by M_p, and the pressure conditions are imposed
+in that metric. The stable-step estimates keep the lumped M_p, which only adds capacity, so
+they stay on the safe side.
+
 Stability needs dt below both the wave limit 2 / omega_max of M_u^-1 K_uu and the diffusion
 limit 2 / lambda_max of M_p^-1 H (forward Euler on the pressure), and somewhat less where the
 two are close. ``stable_steps`` estimates both by power iteration and the step allowed;
