@@ -211,3 +211,14 @@ def test_points_go_to_the_rank_owning_most_of_their_nodes():
     r, c = np.array(rows).T
     B = sp.csr_matrix((np.ones(len(r)), (r, c)), shape=(9, 12))
     assert point_parts(B, part).tolist() == [0, 1, 0]
+
+
+def test_touched_nodes_take_rows_and_columns_of_operators_and_columns_of_conditions():
+    """Fields u (2 per node) then p (1 per node) on 5 nodes: a square operator's entry touches
+    the nodes of its row and its column; a condition's row numbers are not unknowns."""
+    from rkfx.parallel.unknowns import touched_nodes
+
+    a = sp.csr_matrix(([1.0, 2.0], ([3, 11], [12, 0])), shape=(15, 15))  # u of node 1 - p of node 2; p 1 - u 0
+    g = sp.csr_matrix(([1.0], ([4], [14])), shape=(6, 15))  # condition 4 on p of node 4
+    assert touched_nodes((2, 1), 5, a, constraints=(g,)).tolist() == [0, 1, 2, 4]
+    assert touched_nodes((2, 1), 5, g).tolist() == [2, 4]  # read as an operator, row 4 is u of node 2

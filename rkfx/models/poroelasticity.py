@@ -661,7 +661,7 @@ def solve_biot(p: Particles, material: PoroMaterial, times: np.ndarray, output_t
         kuu, kup = (ops.Kuu, ops.Kup) if boundary_terms is None else (ops.Kuu + boundary_terms[0],
                                                                      ops.Kup + boundary_terms[1])
         whole = sp.bmat([[kuu, -kup], [ops.Kup.T, ops.Ks + ops.stabilization(np.ones(n))]], format="csr")
-        touched = touched_nodes((g, 1), n, whole, col.G)
+        touched = touched_nodes((g, 1), n, whole, constraints=(col.G,))
         local = local_unknowns(num, np.unique(np.r_[touched, nb.indices, mine]), (g, 1), comm)
     model = BiotModel(ops, material, col, p.x, loads, local, nitsche=boundary_terms)
     kept = _Outputs(wanted, n, local, g)

@@ -215,14 +215,16 @@ class LocalUnknowns:
         return lambda x: self.share.comm.allreduce(mine @ x)
 
 
-def touched_nodes(components: tuple[int, ...], num_nodes: int, *matrices: sp.spmatrix) -> np.ndarray:
+def touched_nodes(components: tuple[int, ...], num_nodes: int, *matrices: sp.spmatrix,
+                  constraints: tuple[sp.spmatrix, ...] = ()) -> np.ndarray:
     """The nodes whose unknowns (fields of ``components`` values per node, one block after
-    another) are a row or a column of an entry of any of ``matrices``, sorted."""
+    another) are a row or a column of an entry of any of the square ``matrices``, or a column
+    of an entry of any of ``constraints`` (rows of conditions, not of unknowns), sorted."""
     starts = np.r_[0, np.cumsum(np.asarray(components) * num_nodes)]
     found = []
-    for m in matrices:
+    for m, square in [(m, True) for m in matrices] + [(m, False) for m in constraints]:
         m = sp.csr_matrix(m)
-        for unknowns in (m.indices, np.flatnonzero(np.diff(m.indptr))):
+        for unknowns in (m.indices, np.flatnonzero(np.diff(m.indptr))) if square else (m.indices,):
             unknowns = np.asarray(unknowns, np.int64)
             block = np.searchsorted(starts, unknowns, side="right") - 1
             found.append((unknowns - starts[block]) // np.asarray(components)[block])
