@@ -82,7 +82,10 @@ def test_quick_runs_on_ranks_are_the_serial_run(tmp_path, case, ranks):
             x, y = np.asarray(x, float), np.asarray(b["series"][key], float)
             assert np.nanmax(np.abs(x - y)) <= 1e-10 * np.nanmax(np.abs(x)), (a["method"], key)
         for key, x in a["errors"].items():
-            assert abs(x - b["errors"][key]) <= 1e-10 * max(abs(x), 1e-3), (a["method"], key)
+            # An observed rate is a log of a ratio of errors; where those are ~1e-5 of their
+            # quantity (the drained steady state) it carries the series' round-off times 1e5.
+            tol = 1e-8 if key.startswith("rate_") else 1e-10
+            assert abs(x - b["errors"][key]) <= tol * max(abs(x), 1e-3), (a["method"], key)
         for key in ("newton_iterations", "steps", "dt"):
             assert a["info"].get(key) == b["info"].get(key), (a["method"], key)
 

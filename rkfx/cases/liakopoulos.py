@@ -43,13 +43,20 @@ Under ``mpiexec`` both are distributed: the FEM on dolfinx's mesh partition, the
 an RCB split of the particles (each rank integrates over its own nodes' cells and collocates at
 its own boundary nodes; the samples are summed over the ranks; one checkpoint per rank).
 
+Steady state (``steady``, on by default): both methods are also marched to the column's
+drained rest (no flow: dp/dy = -S_w rho_w g) by pseudo-time continuation
+(``rkfx.solvers.steady``), RKPM at ``ny`` and every ``refine_ny``, FEM at ``ny``, against the
+exact quadrature of ``verification.drained_column``: the largest pressure error on the axis
+relative to the top's suction, the settlement's relative error, RKPM's observed rates, and the
+figure steady.png.
+
 The seed compares with Liakopoulos' measurements and with other codes' FEM results; neither is
 reproduced here, the comparison is RKPM against this FEM on the same equations.
 
 Parameters and units (``--set NAME=VALUE``): E [Pa], nu [-], rho_s, rho_w [kg/m^3], porosity [-],
 permeability [m^2], viscosity [Pa s], K_s, K_w [Pa], gravity [m/s^2], W, L [m], retention
 (seed | lewis-schrefler), ny [count], refine_ny (list), rule, output_min (list) [min],
-probes (list) [m], first_step, max_step [s].
+probes (list) [m], first_step, max_step [s], steady [bool].
 
     python -m rkfx.cases.liakopoulos [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
         [--checkpoint-every N] [--resume DIR]
@@ -78,6 +85,8 @@ from rkfx.report.claims import Claim
 from rkfx.solvers.integrate import integrate, time_grid
 from rkfx.solvers.model import Constraints
 from rkfx.solvers.newmark import backward_euler
+from rkfx.solvers.steady import steady_state
+from verification.drained_column import drained_column
 
 NAME = "liakopoulos"
 
@@ -104,6 +113,8 @@ PARAMS = {
     "probes": Param([0.625, 0.975], "heights of the pressure histories [m]"),
     "first_step": Param(1.0, "first time step [s]"),
     "max_step": Param(30.0, "largest time step [s]"),
+    "steady": Param(True, "also march to the drained steady state and compare it with the exact one [bool]",
+                    fingerprint=False),
 }
 QUICK = {"ny": 21, "refine_ny": [41], "output_min": [5.0, 10.0, 20.0, 30.0, 60.0]}
 
@@ -115,7 +126,7 @@ def _soil(E, nu, rho_s, rho_w, porosity, permeability, viscosity, K_s, K_w, grav
 
 
 def check(*, E, nu, rho_s, rho_w, porosity, permeability, viscosity, K_s, K_w, gravity, W, L, retention, ny,
-          refine_ny, rule, output_min, probes, first_step, max_step, **_) -> None:
+          refine_ny, rule, output_min, probes, first_step, max_step, steady=True, **_) -> None:
     """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
     if retention not in RETENTION:
         raise InputError(f"unknown retention {retention!r}; choose from {', '.join(RETENTION)}")
@@ -137,6 +148,8 @@ def check(*, E, nu, rho_s, rho_w, porosity, permeability, viscosity, K_s, K_w, g
     for y in probes:
         if not 0 <= y <= L:
             raise InputError(f"probe height {y!r} m lies outside the column [0, {L}]")
+    if not isinstance(steady, (bool, np.bool_)):
+        raise InputError(f"steady = {steady!r} must be true or false")
 
 
 def memory_need(methods, *, ny, refine_ny, W, L, **_) -> _preflight.Need:
@@ -176,9 +189,9 @@ class _Samples:
         self.t, self.rows = list(arrays["t"]), list(arrays["rows"])
 
 
-def _rkpm(soil, W, L, ny, rule, times, points, io):
-    t0 = time.perf_counter()
-    comm = _cli.comm()
+def rkpm_column(soil, W, L, ny, rule, points, comm=None):
+    """The RKPM model of the column (distributed on ``comm`` of several ranks) and the
+    sampler of [p at ``points``..., u_y at the last one] of its state."""
     d = column_discretization(W, L, *_grid(W, L, ny), rule, comm=comm)
     n = d.particles.num_nodes
     size = 3 * n
@@ -198,8 +211,14 @@ def _rkpm(soil, W, L, ny, rule, times, points, io):
         sample = local.observer(rows)
     else:
         sample = rows.__matmul__
-    model = UnsaturatedBiotModel(d.rule, soil, Constraints(G, np.zeros(G.shape[0])), local)
+    return UnsaturatedBiotModel(d.rule, soil, Constraints(G, np.zeros(G.shape[0])), local), sample
 
+
+def _rkpm(soil, W, L, ny, rule, times, points, io):
+    t0 = time.perf_counter()
+    comm = _cli.comm()
+    model, sample = rkpm_column(soil, W, L, ny, rule, points, comm)
+    size = model.layout.size if model.share is None else int(round(model.share.total(model.share.num_owned)))
     rec = _Samples(sample)
     st = backward_euler()
     out = integrate(st, model, times, start=st.start(model), recorder=rec, comm=comm,
@@ -208,15 +227,15 @@ def _rkpm(soil, W, L, ny, rule, times, points, io):
                                            "steps": len(times) - 1}
 
 
-def _fem(soil, W, L, ny, times, points, io):
+def fem_column(soil, W, L, ny, points, comm=None):
+    """The Taylor-Hood model of the column on the same grid and its sampler (as ``rkpm_column``)."""
     import dolfinx_solver  # noqa: F401, PLC0415
 
     from fem_baselines.poroelasticity import _Sampler, rectangle_mesh  # noqa: PLC0415
     from fem_baselines.unsaturated import FemUnsaturatedModel  # noqa: PLC0415
 
-    t0 = time.perf_counter()
     nx, ny = _grid(W, L, ny)
-    mesh = rectangle_mesh(np.linspace(0.0, W, nx), np.linspace(0.0, L, ny), "quadrilateral", comm=_cli.comm())
+    mesh = rectangle_mesh(np.linspace(0.0, W, nx), np.linspace(0.0, L, ny), "quadrilateral", comm=comm)
     bcs = [Displacement("bottom", components=(1,)), Displacement("left", components=(0,)),
            Displacement("right", components=(0,)), Pressure("bottom")]
     model = FemUnsaturatedModel(mesh, soil, bcs)
@@ -227,6 +246,12 @@ def _fem(soil, W, L, ny, times, points, io):
         p, u = sampler(model.uh, model.ph)
         return np.r_[p[:-1], u[-1, 1]]
 
+    return model, sample
+
+
+def _fem(soil, W, L, ny, times, points, io):
+    t0 = time.perf_counter()
+    model, sample = fem_column(soil, W, L, ny, points, _cli.comm())
     rec = _Samples(sample)
     st = backward_euler()
     out = integrate(st, model, times, start=st.start(model), recorder=rec, comm=_cli.comm(),
@@ -246,14 +271,14 @@ def _series(rec: _Samples, times_s: np.ndarray, n_profile: int, n_probes: int) -
 def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.3e6, nu=0.4, rho_s=2000.0, rho_w=1000.0, porosity=0.2975,
         permeability=4.5e-13, viscosity=1.0e-3, K_s=1.0e12, K_w=2.0e9, gravity=9.806, W=0.1, L=1.0,
         retention="seed", ny=41, refine_ny=(21, 81), rule="nsni", output_min=(5.0, 10.0, 20.0, 30.0, 60.0, 120.0),
-        probes=(0.625, 0.975), first_step=1.0, max_step=30.0, checkpoint_every=0, work_dir=None,
+        probes=(0.625, 0.975), first_step=1.0, max_step=30.0, steady=True, checkpoint_every=0, work_dir=None,
         resume=None) -> Results:
     """The comparison at ``ny`` and the RKPM refinement; see the module docstring."""
     prm = dict(E=E, nu=nu, rho_s=rho_s, rho_w=rho_w, porosity=porosity, permeability=permeability,
                viscosity=viscosity, K_s=K_s, K_w=K_w, gravity=gravity, W=W, L=L, retention=retention, ny=ny,
                refine_ny=list(refine_ny), rule=rule, output_min=list(output_min), probes=list(probes),
                first_step=first_step, max_step=max_step)
-    check(**prm)
+    check(**prm, steady=steady)
     soil = _soil(E, nu, rho_s, rho_w, porosity, permeability, viscosity, K_s, K_w, gravity, retention)
     mat = soil.medium.material
     c_fast = float(np.sqrt((mat.elastic.constrained_modulus + mat.alpha ** 2 / mat.S) / soil.medium.density))
@@ -292,7 +317,49 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.3e6, nu=0.4, rho_s=2000
             r.errors["profile_max"] = float(diff.max())
             r.errors["settlement_end"] = float(abs(s["settlement"][-1] - f["settlement"][-1]) / abs(f["settlement"][-1]))
             r.errors["probes_max"] = float(np.abs(s["probes"] - f["probes"]).max() / np.abs(f["probes"]).max())
+    if steady:
+        _steady_study(results, soil, methods, W, L, ny, refine_ny, rule, first_step)
     return results
+
+
+def _steady_study(results: Results, soil: UnsaturatedSoil, methods, W, L, ny, refine_ny, rule, first_step) -> None:
+    """The drained steady state (t -> infinity: no flow, dp/dy = -S_w rho_w g) by pseudo-time
+    continuation (``rkfx.solvers.steady``) against its exact quadrature
+    (``verification.drained_column``): RKPM at every resolution, FEM at ``ny``."""
+    exact = drained_column(soil, L)
+    jobs = [("fem-taylor-hood steady", ny)] if "fem" in methods else []
+    if "rkpm" in methods:
+        jobs += [(f"rkpm-{rule} steady ny={n}", n) for n in sorted({ny, *refine_ny})]
+    for label, n in jobs:
+        ys = np.linspace(0.0, L, n)
+        points = np.vstack([np.column_stack([np.full(n, 0.5 * W), ys]), [[0.5 * W, L]]])
+        t0 = time.perf_counter()
+        with _cli.model_run(label):
+            comm = _cli.comm()
+            model, sample = (fem_column(soil, W, L, n, points, comm) if label.startswith("fem")
+                             else rkpm_column(soil, W, L, n, rule, points, comm))
+            done = steady_state(model, first_step, comm=comm)
+        values = sample(done.state.x)
+        p_exact = np.interp(ys, exact.y, exact.p)
+        scale = abs(exact.p[-1])
+        unknowns = model.layout.size if label.startswith("fem") else 3 * n * _grid(W, L, n)[0]
+        results.runs.append(Run(label, time.perf_counter() - t0, unknowns,
+                                series={"y": ys, "p": values[:-1], "p_exact": p_exact},
+                                errors={"p_max": float(np.abs(values[:-1] - p_exact).max() / scale),
+                                        "settlement": float(abs(values[-1] - exact.top_displacement)
+                                                            / abs(exact.top_displacement))},
+                                info={"study": "steady", "ny": n, "steps": done.run.steps,
+                                      "newton_iterations": done.run.newton_iterations, "cuts": done.run.cuts,
+                                      "pseudo_time": float(done.times[-1]), "top_suction": scale,
+                                      "top_saturation": float(exact.saturation[-1]),
+                                      "top_displacement": float(values[-1]),
+                                      "top_displacement_exact": exact.top_displacement}))
+    rk = sorted((r for r in results.runs if r.info["study"] == "steady" and r.method.startswith("rkpm")),
+                key=lambda r: r.info["ny"])
+    for coarse, fine in zip(rk, rk[1:]):
+        ratio = (fine.info["ny"] - 1) / (coarse.info["ny"] - 1)
+        for key in ("p_max", "settlement"):
+            fine.errors[f"rate_{key}"] = float(np.log(coarse.errors[key] / fine.errors[key]) / np.log(ratio))
 
 
 def plot(results: Results, out: Path) -> list[Path]:
@@ -321,10 +388,11 @@ def plot(results: Results, out: Path) -> list[Path]:
             a_hist.plot(t, 1e-3 * np.asarray(s["probes"])[:, j], color=f"C{j}", **style,
                         label=f"{r.method}, y = {y:g} m")
         a_set.plot(t, 1e3 * np.asarray(s["settlement"]), color="k" if is_fem else "C3", **style, label=r.method)
-    compared = fem is not None and any(r is not fem for r in results.runs)
+    transient = [r for r in results.runs if r.info["study"] != "steady"]
+    compared = fem is not None and any(r is not fem for r in transient)
     if compared:
         ref = np.asarray(fem.series["profiles"])
-        for r in results.runs:
+        for r in transient:
             if r is fem:
                 continue
             d = np.asarray(r.series["profiles"]) - ref
@@ -360,7 +428,37 @@ def plot(results: Results, out: Path) -> list[Path]:
     for ax in (a_prof, a_hist, a_set) + ((a_diff,) if compared else ()):
         ax.grid(alpha=0.3)
     fig.suptitle(f"Liakopoulos drainage column, {prm['ny']} nodes along the height ({prm['retention']} retention)")
-    return [_cli.save(fig, out / "drainage.png")]
+    figures = [_cli.save(fig, out / "drainage.png")]
+    steady = [r for r in results.runs if r.info["study"] == "steady"]
+    if steady:
+        figures.append(_plot_steady(plt, steady, prm, out))
+    return figures
+
+
+def _plot_steady(plt, runs, prm, out: Path) -> Path:
+    """The drained steady state: profiles against the exact one, and each run's error."""
+    fig, (a_p, a_e) = plt.subplots(1, 2, figsize=(12, 6), layout="constrained")
+    finest = max(runs, key=lambda r: r.info["ny"])
+    a_p.plot(1e-3 * np.asarray(finest.series["p_exact"]), finest.series["y"], color="k", lw=3.0, alpha=0.3,
+             label="exact (quadrature)")
+    for i, r in enumerate(sorted(runs, key=lambda r: (r.method.startswith("rkpm"), r.info["ny"]))):
+        y, p, pe = (np.asarray(r.series[k]) for k in ("y", "p", "p_exact"))
+        fem = r.method.startswith("fem")
+        style = dict(color="k", ls="--", lw=1.4) if fem else dict(color=f"C{i}", lw=1.1)
+        a_p.plot(1e-3 * p, y, **style, label=f"{r.method}")
+        a_e.plot((p - pe) / r.info["top_suction"], y, **style,
+                 label=f"{r.method}: max {r.errors['p_max']:.1e}, settlement {r.errors['settlement']:.1e}")
+    a_p.set_xlabel("water pressure p [kPa]")
+    a_p.set_ylabel("height y [m]")
+    a_p.set_title(f"no flow: dp/dy = -S_w rho_w g; top S_w = {finest.info['top_saturation']:.3f}", fontsize=9)
+    a_e.axvline(0.0, color="k", lw=0.6)
+    a_e.set_xlabel("(p - p_exact) / |p_exact(L)|")
+    a_e.set_title("error on the axis, and relative error of the top's settlement", fontsize=9)
+    for ax in (a_p, a_e):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle("Liakopoulos column drained to its steady state (pseudo-time continuation, backward Euler)")
+    return _cli.save(fig, out / "steady.png")
 
 
 CLAIMS = [
@@ -370,6 +468,10 @@ CLAIMS = [
           run="rkpm-nsni", info={"study": "comparison"}, key="profile_120min", op="<", bound=0.05, full_only=True),
     Claim("RKPM settlement at the end within 5 % of the FEM baseline",
           run="rkpm-nsni", info={"study": "comparison"}, key="settlement_end", op="<", bound=0.05),
+    Claim("Drained steady state: the RKPM profile at 41 rows within 1e-4 of the top suction of the exact one",
+          run="rkpm-nsni steady ny=41", info={"study": "steady"}, key="p_max", op="<", bound=1e-4),
+    Claim("Drained steady state: the RKPM profile converges at a rate above 1.5 from 21 to 41 rows",
+          run="rkpm-nsni steady ny=41", info={"study": "steady"}, key="rate_p_max", op=">", bound=1.5),
 ]
 
 
