@@ -214,16 +214,21 @@ def rkpm_column(soil, W, L, ny, rule, points, comm=None):
     return UnsaturatedBiotModel(d.rule, soil, Constraints(G, np.zeros(G.shape[0])), local), sample
 
 
+def _unknowns(model) -> int:
+    """The whole model's unknowns (an RKPM model on ranks counts its owned ones over all ranks)."""
+    share = getattr(model, "share", None)
+    return model.layout.size if share is None else int(round(share.total(share.num_owned)))
+
+
 def _rkpm(soil, W, L, ny, rule, times, points, io):
     t0 = time.perf_counter()
     comm = _cli.comm()
     model, sample = rkpm_column(soil, W, L, ny, rule, points, comm)
-    size = model.layout.size if model.share is None else int(round(model.share.total(model.share.num_owned)))
     rec = _Samples(sample)
     st = backward_euler()
     out = integrate(st, model, times, start=st.start(model), recorder=rec, comm=comm,
                     progress=lambda it: _cli.progress(it, f"rkpm-{rule} ny={ny}", len(times) - 1), **io)
-    return rec, time.perf_counter() - t0, {"unknowns": size, "newton_iterations": out.newton_iterations, "cuts": out.cuts,
+    return rec, time.perf_counter() - t0, {"unknowns": _unknowns(model), "newton_iterations": out.newton_iterations, "cuts": out.cuts,
                                            "steps": len(times) - 1}
 
 
@@ -342,8 +347,7 @@ def _steady_study(results: Results, soil: UnsaturatedSoil, methods, W, L, ny, re
         values = sample(done.state.x)
         p_exact = np.interp(ys, exact.y, exact.p)
         scale = abs(exact.p[-1])
-        unknowns = model.layout.size if label.startswith("fem") else 3 * n * _grid(W, L, n)[0]
-        results.runs.append(Run(label, time.perf_counter() - t0, unknowns,
+        results.runs.append(Run(label, time.perf_counter() - t0, _unknowns(model),
                                 series={"y": ys, "p": values[:-1], "p_exact": p_exact},
                                 errors={"p_max": float(np.abs(values[:-1] - p_exact).max() / scale),
                                         "settlement": float(abs(values[-1] - exact.top_displacement)

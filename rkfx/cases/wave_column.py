@@ -286,7 +286,8 @@ def plot(results: Results, out: Path) -> list[Path]:
         axes[1, 0].legend(fontsize=7, loc="center right")
         axes[0, 1].set_title("grey bands: +-exclude around the fronts (left out of the L2 errors)", fontsize=8)
         what = f"{prm['ny']} nodes along the height" if study == "rules" else "NSNI under refinement"
-        fig.suptitle(f"Saturated column under a step load, {what} (fast wave {prm['fast_speed']:.0f} m/s)")
+        fpp = ", RKPM with the pressure projection (fpp)" if prm.get("fpp") else ""
+        fig.suptitle(f"Saturated column under a step load, {what} (fast wave {prm['fast_speed']:.0f} m/s){fpp}")
         files.append(_cli.save(fig, out / name))
     return files
 

@@ -68,16 +68,17 @@ def steady_state(model: Model, first_step: float, *, growth: float = 2.0, rtol: 
     times = np.r_[0.0, first_step * np.cumsum(growth ** np.arange(max_steps))]
     blocks = [model.layout.block(f.name) for f in model.layout.fields]
     largest = (lambda v: v) if comm is None or comm.size == 1 else (lambda v: max(comm.allgather(v)))
-    last = {"x": start.x.copy()}
+    previous = start.x.copy()
     change: list[float] = []
 
     def settled(state: StepState) -> bool:
+        nonlocal previous
         worst = 0.0
         for b in blocks:
-            step = largest(float(np.max(np.abs(state.x[b] - last["x"][b]), initial=0.0)))
+            step = largest(float(np.max(np.abs(state.x[b] - previous[b]), initial=0.0)))
             size = largest(float(np.max(np.abs(state.x[b]), initial=0.0)))
             worst = max(worst, step / size if size > 0 else 0.0)
-        last["x"] = state.x.copy()
+        previous = state.x.copy()
         change.append(worst)
         return worst <= rtol
 
