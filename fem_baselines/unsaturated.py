@@ -4,7 +4,7 @@ column (the equations of ``rkfx.models.unsaturated_poroelasticity``, eqs. 6.15-6
 Taylor-Hood (P2-P1 or Q2-Q1) with the Galerkin forms
 
     F_u = int sigma''(u) : eps(v) - alpha S p div v - n rho_w (S - 1) g . v
-    F_p = int k k_rw (grad p - S rho_w g) . grad q
+    F_p = int k k_rw (grad p - S rho_w g) . grad q  [+ int_face kappa <p>_+ q ds]
     c   = int q (alpha S div u' + p' / Q)
 
 and their exact derivatives (d(1/Q)/dp by central differences, as in the RKPM model). The
@@ -32,6 +32,7 @@ import ufl
 from fem_baselines.elasticity import strain, stress_law
 from fem_baselines.poroelasticity import FemBiotModel, _global_matrix, _global_vector
 from rkfx.conditions import Condition
+from rkfx.errors import InputError
 from rkfx.models.unsaturated_poroelasticity import UnsaturatedSoil
 
 #: Names of the coefficient Functions on the quadrature space (``UnsaturatedSoil.coefficients``).
@@ -46,10 +47,12 @@ class FemUnsaturatedModel(FemBiotModel):
         soil: Constituents, retention law and gravity (g along -y).
         conditions: ``rkfx.conditions`` (Displacement, Pressure; Traction and Flux as loads).
         quadrature_degree: Of every form and of the coefficient space.
+        seepage: ``(part, kappa)``: a seepage face on a boundary part with the one-sided outflow
+            kappa <p>_+ [m/(Pa s)] of ``rkfx.assembly.seepage_face``, or ``None``.
     """
 
     def __init__(self, mesh: dolfinx.mesh.Mesh, soil: UnsaturatedSoil, conditions: Sequence[Condition],
-                 quadrature_degree: int = 4):
+                 quadrature_degree: int = 4, seepage: tuple | None = None):
         m = soil.medium
         mat = m.material
         super().__init__(mesh, m.E, m.nu, m.k, mat.alpha, mat.S, "taylor-hood", conditions)
@@ -76,16 +79,30 @@ class FemUnsaturatedModel(FemBiotModel):
         form = dolfinx.fem.form
         self._F_u = form((ufl.inner(sigma(u), strain(v)) - alpha * S * p * ufl.div(v)
                           - n * rho * (S - 1.0) * ufl.inner(g, v)) * dx)
-        self._F_p = form(k * kr * ufl.inner(flux, ufl.grad(q)) * dx)
+        F_p = k * kr * ufl.inner(flux, ufl.grad(q)) * dx
         self._J_uu = form(ufl.inner(sigma(du), strain(v)) * dx)
         self._J_up = form((-alpha * (S + dS * p) * dp * ufl.div(v) - n * rho * dS * dp * ufl.inner(g, v)) * dx)
-        self._J_pp = form((k * kr * ufl.inner(ufl.grad(dp), ufl.grad(q)) + k * dkr * dp * ufl.inner(grad_p, ufl.grad(q))
-                           - k * kr * dS * dp * rho * ufl.inner(g, ufl.grad(q))) * dx)
+        J_pp = (k * kr * ufl.inner(ufl.grad(dp), ufl.grad(q)) + k * dkr * dp * ufl.inner(grad_p, ufl.grad(q))
+                - k * kr * dS * dp * rho * ufl.inner(g, ufl.grad(q))) * dx
         self._c_p = form(q * (alpha * S * ufl.div(self.vu) + iQ * self.vp) * dx)
         self._C_x = form(q * (alpha * dS * ufl.div(self.vu) + diQ * self.vp) * dp * dx)
         self._C_vu = form(q * alpha * S * ufl.div(du) * dx)
         self._C_vp = form(q * iQ * dp * dx)
+        self._face = None
+        if seepage is not None:
+            part, kappa = seepage
+            if not (np.isfinite(kappa) and kappa > 0):
+                raise InputError(f"seepage face penalty = {kappa!r} must be a positive outflow per unit pressure "
+                                 "[m/(Pa s)], e.g. 1e3 k / h")
+            ds = ufl.Measure("ds", domain=mesh, subdomain_data=self.boundary.tags([part], "seepage face"))(1)
+            wet = ufl.conditional(ufl.gt(p, 0.0), 1.0, 0.0)
+            outflow = const(kappa) * ufl.max_value(p, 0.0)
+            self._face = form(outflow * ds)
+            F_p = F_p + outflow * q * ds
+            J_pp = J_pp + const(kappa) * wet * dp * q * ds
+        self._F_p, self._J_pp = form(F_p), form(J_pp)
         self._kuu = _global_matrix(self._J_uu, self.comm)
+        self._q = [form(-k * kr * flux[j] * dx) for j in range(2)]
 
     # ------------------------------------------------------------------ state
 
@@ -131,6 +148,19 @@ class FemUnsaturatedModel(FemBiotModel):
 
     def equation_weights(self, co) -> None:
         return None
+
+    def flux_integral(self, x: np.ndarray) -> np.ndarray:
+        """int q dA of Darcy's flux q = -k k_rw (grad p - S_w rho_w g) over the mesh, shape
+        ``(2,)`` [m^3/s per m], summed over the ranks (collective)."""
+        self._set(x)
+        return np.array([self.comm.allreduce(dolfinx.fem.assemble_scalar(q)) for q in self._q])
+
+    def seepage_outflow(self, x: np.ndarray) -> float:
+        """int_face kappa <p>_+ ds [m^2/s per m] (0 without a face), summed over the ranks (collective)."""
+        if self._face is None:
+            return 0.0
+        self._set(x)
+        return float(self.comm.allreduce(dolfinx.fem.assemble_scalar(self._face)))
 
     def pressure_function(self, x: np.ndarray) -> dolfinx.fem.Function:
         """p_h of the unknowns ``x`` (a new Function)."""

@@ -9,7 +9,8 @@ import pytest
 
 # (script, ranks): the elastostatic solves are assembled by owned rows on more than one rank.
 RUNS = [("solve_manufactured.py", 2), ("solve_manufactured.py", 3), ("solve_patch.py", 2), ("solve_patch.py", 3),
-        ("solve_mandel.py", 2), ("solve_mandel.py", 3), ("solve_3d.py", 2), ("solve_3d.py", 3)]
+        ("solve_mandel.py", 2), ("solve_mandel.py", 3), ("solve_3d.py", 2), ("solve_3d.py", 3),
+        ("steady_dam.py", 2), ("steady_dam.py", 3)]
 MPIEXEC = Path(sys.executable).parent / "mpiexec"
 
 
@@ -18,7 +19,8 @@ MPIEXEC = Path(sys.executable).parent / "mpiexec"
 @pytest.mark.parametrize(("script", "ranks"), RUNS)
 def test_serial_and_parallel_agree(tmp_path, script, ranks):
     """Elastostatics on gmsh nodes (manufactured solution, patch test), a u-p time loop, and both
-    in 3-D: the same answer on 1 rank and on 2 or 3."""
+    in 3-D, and a steady unsaturated seepage through a seepage face (RKPM and FEM): the same
+    answer on 1 rank and on 2 or 3."""
     a, b = _serial_and_parallel(tmp_path, script, ranks)
     assert np.abs(a - b).max() <= 1e-10 * np.abs(a).max()
 

@@ -23,7 +23,7 @@ def _triplets(a: sp.csr_matrix, b: sp.csr_matrix):
     ca, cb = np.diff(a.indptr), np.diff(b.indptr)
     per = ca * cb
     point = np.repeat(np.arange(a.shape[0]), per)
-    start = np.repeat(np.r_[0, np.cumsum(per)[:-1]], per)
+    start = np.repeat(np.cumsum(per) - per, per)
     local = np.arange(per.sum()) - start
     cbp = cb[point]
     ia = a.indptr[point] + local // np.maximum(cbp, 1)

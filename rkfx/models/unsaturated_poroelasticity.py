@@ -34,6 +34,7 @@ import scipy.sparse as sp
 
 from rkfx.assembly import nodal_forms
 from rkfx.assembly.operators import strain_matrix
+from rkfx.assembly.seepage_face import SeepageFace
 from rkfx.assembly.weighted_forms import WeightedForm, placed
 from rkfx.errors import InputError
 from rkfx.integration.nodal_stabilized import NodalIntegration
@@ -102,14 +103,19 @@ class UnsaturatedBiotModel(Stateless):
             (``nodal_integration(..., points=)``): the model then lives on the local nodes and
             returns the contributions of its points (``share`` tells the steppers, which add
             them up). ``None``: the whole model.
+        seepage: A seepage face (``rkfx.assembly.seepage_face``): outflow kappa <p>_+ through it
+            (with ``local``, the rank's own points over the whole node set).
     """
 
     def __init__(self, rule: NodalIntegration, soil: UnsaturatedSoil, constraints: Constraints,
-                 local: LocalUnknowns | None = None):
+                 local: LocalUnknowns | None = None, seepage: SeepageFace | None = None):
         self.local = local
         self.share = None if local is None else local.share
         if local is not None:
             rule = rule.localized(local.nodes)
+            seepage = None if seepage is None else seepage.localized(local.nodes)
+        self.seepage = seepage
+        self._face = None if seepage is None else seepage.matrix()
         n = rule.values.num_cols
         self.n, self.rule, self.soil = n, rule, soil
         self.layout = layout(("u", 2, 1), ("p", 1, 1), nodes=n)
@@ -146,6 +152,8 @@ class UnsaturatedBiotModel(Stateless):
         pairs += [(on_p(r), on_p(r)) for _, rows in self.expansion for r in rows]
         pairs += [(on_p(self.test[j]), N) for j in range(2)]                    # dk, dS of the flux
         pairs += [(on_p(r), N) for _, rows in self.expansion for r in rows]
+        if self._face is not None:
+            pairs += [(on_p(self._face), on_p(self._face))]                     # d(kappa <p>_+)/dp
         self._tangent = WeightedForm(pairs, (size, size), constant=placed(sp.vstack([self.K, sp.csr_matrix((n, 2 * n))]),
                                                                            size))
         self._rate_x = WeightedForm([(N, N)], (size, size))
@@ -160,6 +168,34 @@ class UnsaturatedBiotModel(Stateless):
     def saturation(self, x: np.ndarray) -> np.ndarray:
         """S_w at the integration points, shape ``(num_points,)``."""
         return self.soil.retention.saturation(-self.pressures(x))
+
+    def darcy_flux(self, x: np.ndarray) -> np.ndarray:
+        """Darcy's flux q = -k k_rw (grad p - S_w rho_w g) at the integration points, shape
+        ``(num_points, 2)`` [m/s], with the trial gradients of the rule."""
+        m = self.soil.medium
+        P = x[2 * self.n:]
+        c = self.soil.coefficients(self.N @ P)
+        k = m.k * c["kr"]
+        return np.column_stack([-k * (self.trial[j] @ P - c["S"] * m.rho_f * self.g[j]) for j in range(2)])
+
+    def flux_integral(self, x: np.ndarray) -> np.ndarray:
+        """int q dA over the domain by the rule, shape ``(2,)`` [m^3/s per m]; on MPI ranks the
+        sum over every rank's points (collective)."""
+        local = self.V @ self.darcy_flux(x)
+        return local if self.share is None else np.array([self.share.total(v) for v in local])
+
+    def seepage_pressures(self, x: np.ndarray) -> np.ndarray:
+        """p^h at the seepage face's points (``seepage.points``; a rank's own), shape ``(num_points,)`` [Pa]."""
+        return self._face @ x[2 * self.n:]
+
+    def seepage_outflow(self, x: np.ndarray) -> float:
+        """The outflow through the seepage face, int kappa <p>_+ ds [m^2/s per m] (0 without a
+        face; on MPI ranks the sum over the ranks, collective)."""
+        local = 0.0
+        if self._face is not None:
+            f = self.seepage
+            local = float(f.weights @ (f.penalty * np.maximum(self._face @ x[2 * self.n:], 0.0)))
+        return local if self.share is None else self.share.total(local)
 
     # ------------------------------------------------------------------ model
 
@@ -182,13 +218,17 @@ class UnsaturatedBiotModel(Stateless):
             d = [b @ P for b in rows]
             second.append(d)
             r_p = r_p + sum(rows[j].T @ (mom * k * d[j]) for j in range(2))
-        self._at = (pL, c, grad, second)
+        face = None
+        if self._face is not None:
+            face = self._face @ P
+            r_p = r_p + self._face.T @ (self.seepage.weights * self.seepage.penalty * np.maximum(face, 0.0))
+        self._at = (pL, c, grad, second, face)
         return np.r_[r_u, r_p]
 
     def tangent(self, x: np.ndarray, t: float) -> sp.csr_matrix:
         V, soil = self.V, self.soil
         m = soil.medium
-        pL, c, grad, second = self._at
+        pL, c, grad, second, face = self._at
         k, dk = m.k * c["kr"], m.k * c["dkr"]
         w = [-V * soil.alpha * (c["S"] + c["dS"] * pL)]
         w += [-V * m.porosity * m.rho_f * c["dS"] * self.g[j] for j in self._components]
@@ -196,6 +236,8 @@ class UnsaturatedBiotModel(Stateless):
         w += [mom * k for mom, rows in self.expansion for _ in rows]
         w += [V * (dk * (grad[j] - c["S"] * m.rho_f * self.g[j]) - k * c["dS"] * m.rho_f * self.g[j]) for j in range(2)]
         w += [mom * dk * d[j] for (mom, _), d in zip(self.expansion, second) for j in range(2)]
+        if face is not None:
+            w += [self.seepage.weights * self.seepage.penalty * (face > 0.0)]
         return self._tangent(w)
 
     def rate_force(self, x: np.ndarray, v: np.ndarray) -> np.ndarray:
