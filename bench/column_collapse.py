@@ -4,11 +4,12 @@ The set-up of Bui et al. (2008): a column 0.2 m long and 0.1 m high against a sm
 x = 0, released at t = 0 onto a floor with Coulomb friction; E = 0.84 MPa, nu = 0.3,
 rho = 2650 kg/m^3, phi = 19.8 deg, c = 0, psi = 0; geostatic start with K0 = 1 - sin(phi).
 ``rkfx.models.lagrangian_plasticity`` on a grid of ``nx`` particles across, a = 2 h,
-central differences at ``cfl`` h / c. Prints the state every tenth of the run and a last line
+central differences at ``cfl`` h / c;
+``--support`` sets a in spacings (2 by default). Prints the state every tenth of the run and a last line
 with the run-out, the height at the wall, how long the run went and why it stopped.
 
     python bench/column_collapse.py [--nx 21] [--rule nsni] [--t-end 0.7] [--viscosity 0]
-        [--cfl 0.3] [--floor-friction 0.36]
+        [--cfl 0.3] [--support 2] [--floor-friction 0.36]
 """
 import argparse
 import time
@@ -48,6 +49,7 @@ def main() -> None:
     ap.add_argument("--t-end", type=float, default=0.7)
     ap.add_argument("--viscosity", type=float, default=0.0)
     ap.add_argument("--cfl", type=float, default=0.3)
+    ap.add_argument("--support", type=float, default=2.0, help="support radius a_I in particle spacings")
     ap.add_argument("--floor-friction", type=float, default=float(np.tan(np.radians(19.8))))
     args = ap.parse_args()
     width, height = 0.2, 0.1
@@ -61,11 +63,11 @@ def main() -> None:
     c = np.sqrt((soil.bulk_modulus + 4.0 * soil.shear_modulus / 3.0) / rho)
     dt = args.cfl * h / c
     walls = [Wall((0, 0), (0, 1), args.floor_friction, "floor"), Wall((0, 0), (1, 0), 0.0, "wall")]
-    model = LagrangianPlasticity(p.x, nodal_domains(p).area, 2.0 * h, p.boundary_edges, soil, rho, dt, rule=args.rule,
+    model = LagrangianPlasticity(p.x, nodal_domains(p).area, args.support * h, p.boundary_edges, soil, rho, dt, rule=args.rule,
                                  walls=walls, stress=stress, gravity=(0.0, -g), viscosity=args.viscosity)
     steps = int(np.ceil(args.t_end / dt))
     print(f"{len(p.x)} particles, h = {h:.4g} m, dt = {dt:.3g} s, {steps} steps, rule {args.rule}, "
-          f"viscosity {args.viscosity}", flush=True)
+          f"a = {args.support} h, viscosity {args.viscosity}", flush=True)
     t0 = time.perf_counter()
     why = "ran to t_end"
     try:
