@@ -118,7 +118,8 @@ def rkpm_dam(soil: UnsaturatedSoil, dam: Dam, ny: int, comm=None, rule: str = "n
     the nodes are split by RCB and each rank holds its own nodes' rows, conditions and face
     points (``model.share``)."""
     from rkfx.assembly.seepage_face import seepage_face  # noqa: PLC0415
-    from rkfx.cases._confined_column import column_discretization, column_unknowns  # noqa: PLC0415
+    from rkfx.cases._confined_column import column_discretization  # noqa: PLC0415
+    from rkfx.cases._nodal_up import rank_unknowns  # noqa: PLC0415
 
     nx = int(round((ny - 1) * dam.length / dam.height)) + 1
     d = column_discretization(dam.length, dam.height, nx, ny, rule, comm=comm)
@@ -143,7 +144,7 @@ def rkpm_dam(soil: UnsaturatedSoil, dam: Dam, ny: int, comm=None, rule: str = "n
     local = None
     if d.own is not None:
         touched = G if face is None else sp.vstack([G, placed(face.matrix(), size, 2 * n)])
-        local = column_unknowns(d, touched, comm)
+        local = rank_unknowns(d, touched, comm)
         G = G[:, local.index].tocsr()
     return UnsaturatedBiotModel(d.rule, soil, Constraints(G, g), local, seepage=face)
 

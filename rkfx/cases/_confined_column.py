@@ -8,7 +8,7 @@ base fixed in y and impermeable, the top drained (p = 0) and loaded by a compres
 q from t = 0.
 
 On a communicator of several ranks the nodes are split by RCB: each rank's rule covers its own
-nodes' cells only, and ``column_unknowns`` gives its local unknowns (own nodes, then ghosts).
+nodes' cells only, and ``rkfx.cases._nodal_up.rank_unknowns`` gives its local unknowns (own nodes, then ghosts).
 """
 from collections.abc import Callable
 from typing import NamedTuple
@@ -16,15 +16,13 @@ from typing import NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from rkfx.approximation.semi_lagrangian import MovingRK, evaluate_moving, moving_rk
+from rkfx.approximation.semi_lagrangian import MovingRK, evaluate_moving
+from rkfx.cases._nodal_up import nodal_discretization, rank_unknowns
 from rkfx.errors import InputError
-from rkfx.geometry.nodal_domains import nodal_domains
 from rkfx.geometry.particles import Particles, structured
-from rkfx.integration.nodal_stabilized import NodalIntegration, boundary_rule, nodal_cells, nodal_integration
+from rkfx.integration.nodal_stabilized import NodalIntegration, boundary_rule
 from rkfx.models.explicit_poroelasticity import Constituents, ExplicitPoroDynamics, collocation_rows
-from rkfx.parallel.ownership import Numbering, numbering
-from rkfx.parallel.partition import rcb
-from rkfx.parallel.unknowns import LocalUnknowns, local_unknowns
+from rkfx.parallel.ownership import Numbering
 from rkfx.solvers.central_difference import Constraint
 
 #: The data of §6.4.1 (Soares 2014).
@@ -56,26 +54,10 @@ def column_discretization(width: float, height: float, nx: int, ny: int, rule: s
         raise InputError(f"nx = {nx}, ny = {ny} give unequal spacings {width / (nx - 1):.4g} and {h:.4g} m on a "
                          f"{width} x {height} m column; take nx - 1 = (ny - 1) width / height")
     p = structured(width, height, nx, ny)
-    cells = nodal_cells(p.x, nodal_domains(p).area)
-    rk = moving_rk(p.x, 2.0 * h, 0.5 * h, reach=cells.reach)
-    num = own = None
-    if comm is not None and comm.size > 1:
-        num = numbering(rcb(p.x, comm.size), comm.size)
-        own = np.sort(num.old_of_new[num.ranges[comm.rank]:num.ranges[comm.rank + 1]])
-    r = nodal_integration(rk, cells, boundary_rule(p.x, p.boundary_edges), rule, points=own)
+    d = nodal_discretization(p, h, rule, comm)
     x, tol = p.x, 1e-9 * height
-    return ColumnDiscretization(p, rk, r, np.flatnonzero(x[:, 1] < tol), np.flatnonzero(x[:, 1] > height - tol),
-                                np.flatnonzero((x[:, 0] < tol) | (x[:, 0] > width - tol)), own, num)
-
-
-def column_unknowns(d: ColumnDiscretization, constraints: sp.spmatrix, comm) -> LocalUnknowns:
-    """On MPI ranks, a rank's local u-p unknowns (``u`` interleaved, then ``p``) of a column split
-    by ``column_discretization(..., comm=)``: its own nodes, then the ghosts its rule's rows and
-    the ``constraints`` rows (over the whole vector) touch. Collective."""
-    n = d.particles.num_nodes
-    cols = sp.csr_matrix(constraints).indices
-    touched = np.unique(np.r_[d.own, np.where(cols < 2 * n, cols // 2, cols - 2 * n), d.rule.columns()])
-    return local_unknowns(d.numbering, touched, (2, 1), comm)
+    return ColumnDiscretization(p, d.rk, d.rule, np.flatnonzero(x[:, 1] < tol), np.flatnonzero(x[:, 1] > height - tol),
+                                np.flatnonzero((x[:, 0] < tol) | (x[:, 0] > width - tol)), d.own, d.numbering)
 
 
 class ConfinedColumn(NamedTuple):
@@ -128,7 +110,7 @@ def confined_column(ny: int, rule: str = "nsni", medium: Constituents = SOARES, 
                        collocation_rows(rk, np.flatnonzero(axis & (x[:, 1] < tol)), None, n, 2 * n, size)]).tocsr()
     local = None
     if d.own is not None:
-        local = column_unknowns(d, sp.vstack(rows), comm)
+        local = rank_unknowns(d, sp.vstack(rows), comm)
         rows = [g[:, local.index].tocsr() for g in rows]
     essential = [Constraint(g) for g in rows]
     return ConfinedColumn(ExplicitPoroDynamics(r, medium, essential, load=lambda t: f, local=local, fpp=fpp), int(top[0]),

@@ -74,7 +74,8 @@ from rkfx.approximation.semi_lagrangian import evaluate_moving
 from rkfx.assembly.weighted_forms import placed
 from rkfx.cases import _cli, _preflight
 from rkfx.cases._cli import Param, Results, Run
-from rkfx.cases._confined_column import column_discretization, column_unknowns
+from rkfx.cases._confined_column import column_discretization
+from rkfx.cases._nodal_up import rank_unknowns
 from rkfx.conditions import Displacement, Pressure
 from rkfx.errors import InputError
 from rkfx.integration.nodal_stabilized import RULES
@@ -206,7 +207,7 @@ def rkpm_column(soil, W, L, ny, rule, points, comm=None):
     rows = sp.vstack([placed(rows[:-1], size, 2 * n), placed(rows[-1:], size, 1, 2)]).tocsr()
     local = None
     if ranks:
-        local = column_unknowns(d, G, comm)
+        local = rank_unknowns(d, G, comm)
         G = G[:, local.index].tocsr()
         sample = local.observer(rows)
     else:
