@@ -3,7 +3,7 @@ column (the equations of ``rkfx.models.unsaturated_poroelasticity``, eqs. 6.15-6
 
 Taylor-Hood (P2-P1 or Q2-Q1) with the Galerkin forms
 
-    F_u = int sigma''(u) : eps(v) - alpha S p div v - n rho_w (S - 1) g . v
+    F_u = int sigma''(u) : eps(v) - alpha S p div v - (rho_0 + n rho_w S) g . v
     F_p = int k k_rw (grad p - S rho_w g) . grad q  [+ int_face kappa <p>_+ q ds]
     c   = int q (alpha S div u' + p' / Q)
 
@@ -33,7 +33,7 @@ from fem_baselines.elasticity import strain, stress_law
 from fem_baselines.poroelasticity import FemBiotModel, _global_matrix, _global_vector
 from rkfx.conditions import Condition
 from rkfx.errors import InputError
-from rkfx.models.unsaturated_poroelasticity import UnsaturatedSoil
+from rkfx.models.unsaturated_poroelasticity import WEIGHTS, UnsaturatedSoil
 
 #: Names of the coefficient Functions on the quadrature space (``UnsaturatedSoil.coefficients``).
 COEFFICIENTS = ("S", "dS", "kr", "dkr", "iQ", "diQ")
@@ -49,13 +49,21 @@ class FemUnsaturatedModel(FemBiotModel):
         quadrature_degree: Of every form and of the coefficient space.
         seepage: ``(part, kappa)``: a seepage face on a boundary part with the one-sided outflow
             kappa <p>_+ [m/(Pa s)] of ``rkfx.assembly.seepage_face``, or ``None``.
+        weight: The skeleton's body load, as in the RKPM model: rho_0 = -n rho_w (``"change"``,
+            from the saturated state) or (1 - n) rho_s (``"full"``).
+        facet_tags, physical_groups: Of a gmsh mesh (``fem_baselines.gmsh_mesh``), so that
+            conditions may name its boundary groups.
     """
 
     def __init__(self, mesh: dolfinx.mesh.Mesh, soil: UnsaturatedSoil, conditions: Sequence[Condition],
-                 quadrature_degree: int = 4, seepage: tuple | None = None):
+                 quadrature_degree: int = 4, seepage: tuple | None = None, weight: str = "change",
+                 facet_tags=None, physical_groups=None):
+        if weight not in WEIGHTS:
+            raise InputError(f"weight = {weight!r}: choose {' or '.join(WEIGHTS)}")
         m = soil.medium
         mat = m.material
-        super().__init__(mesh, m.E, m.nu, m.k, mat.alpha, mat.S, "taylor-hood", conditions)
+        super().__init__(mesh, m.E, m.nu, m.k, mat.alpha, mat.S, "taylor-hood", conditions, facet_tags=facet_tags,
+                         physical_groups=physical_groups)
         self.soil, self.linear = soil, False
         cell = mesh.topology.cell_name()
         W = dolfinx.fem.functionspace(mesh, basix.ufl.quadrature_element(cell, value_shape=(), degree=quadrature_degree))
@@ -69,6 +77,7 @@ class FemUnsaturatedModel(FemBiotModel):
         scalar = dolfinx.default_scalar_type
         const = lambda value: dolfinx.fem.Constant(mesh, scalar(value))  # noqa: E731
         alpha, n, rho, k = const(mat.alpha), const(m.porosity), const(m.rho_f), const(m.k)
+        rho_0 = const(-m.porosity * m.rho_f if weight == "change" else (1.0 - m.porosity) * m.rho_s)
         g = dolfinx.fem.Constant(mesh, np.array([0.0, -soil.gravity], dtype=scalar))
         S, dS, kr, dkr, iQ, diQ = (self.coef[c] for c in COEFFICIENTS)
         sigma = stress_law(mesh, mat.elastic)
@@ -78,7 +87,7 @@ class FemUnsaturatedModel(FemBiotModel):
         flux = grad_p = ufl.grad(p) - S * rho * g
         form = dolfinx.fem.form
         self._F_u = form((ufl.inner(sigma(u), strain(v)) - alpha * S * p * ufl.div(v)
-                          - n * rho * (S - 1.0) * ufl.inner(g, v)) * dx)
+                          - (rho_0 + n * rho * S) * ufl.inner(g, v)) * dx)
         F_p = k * kr * ufl.inner(flux, ufl.grad(q)) * dx
         self._J_uu = form(ufl.inner(sigma(du), strain(v)) * dx)
         self._J_up = form((-alpha * (S + dS * p) * dp * ufl.div(v) - n * rho * dS * dp * ufl.inner(g, v)) * dx)

@@ -38,21 +38,15 @@ import scipy.sparse as sp
 from scipy.integrate import quad
 
 from rkfx.assembly.weighted_forms import placed
-from rkfx.materials.retention import VanGenuchten
-from rkfx.models.explicit_poroelasticity import Constituents, collocation_rows
+from rkfx.models.explicit_poroelasticity import collocation_rows
 from rkfx.models.unsaturated_poroelasticity import UnsaturatedBiotModel, UnsaturatedSoil
 from rkfx.solvers.model import Constraints
 
-#: Hydraulic conductivity of the levee sand [m/s] (see the module docstring).
-CONDUCTIVITY = 5.0e-4
-
-
 def levee_sand(gravity: float = 9.806) -> UnsaturatedSoil:
-    """The sand of §6.4.3 with van Genuchten's retention (6.82-6.83)."""
-    gamma_w = 1000.0 * gravity
-    medium = Constituents(E=1.0e7, nu=0.3, rho_s=2700.0, rho_f=1000.0, porosity=0.46, k=CONDUCTIVITY / gamma_w,
-                          K_s=1.0e22, K_f=1.0e9)
-    return UnsaturatedSoil(medium, VanGenuchten(S_rw=0.0842, n=2.0, beta=0.7, gamma_w=gamma_w), gravity)
+    """The sand of §6.4.3 with van Genuchten's retention (6.82-6.83), as ``rkfx.cases.levee`` has it."""
+    from rkfx.cases.levee import sand  # noqa: PLC0415
+
+    return sand(gravity=gravity)
 
 
 @dataclass(frozen=True)

@@ -27,6 +27,8 @@ the machine cannot hold it), see ``rkfx.cases._preflight``.
                       DNI, Taylor-Hood with the trapezoid, the exact Laplace-domain solution.
     liakopoulos       unsaturated drainage of a sand column (seed 6.4.2): implicit RKPM u-p on
                       NSNI with the retention law against Taylor-Hood on the same grid.
+    levee             a levee's initial state (seed 6.4.3, stage 1): steady seepage under gravity
+                      through a seepage face, RKPM on gmsh nodes beside Taylor-Hood.
     cryer             Cryer's poroelastic sphere (3-D, seed 3.3.2): RKPM SCNI + FPP on gmsh
                       tetrahedra against the exact solution, NI's early oscillation, Taylor-Hood.
 """

@@ -16,11 +16,11 @@ from typing import NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from rkfx.approximation.semi_lagrangian import MovingRK, evaluate_moving
-from rkfx.cases._nodal_up import nodal_discretization, rank_unknowns
+from rkfx.approximation.semi_lagrangian import MovingRK
+from rkfx.cases._nodal_up import edge_load, nodal_discretization, rank_unknowns
 from rkfx.errors import InputError
 from rkfx.geometry.particles import Particles, structured
-from rkfx.integration.nodal_stabilized import NodalIntegration, boundary_rule
+from rkfx.integration.nodal_stabilized import NodalIntegration
 from rkfx.models.explicit_poroelasticity import Constituents, ExplicitPoroDynamics, collocation_rows
 from rkfx.parallel.ownership import Numbering
 from rkfx.solvers.central_difference import Constraint
@@ -102,9 +102,8 @@ def confined_column(ny: int, rule: str = "nsni", medium: Constituents = SOARES, 
             collocation_rows(rk, sides, 0, n, 0, size),       # rollers
             collocation_rows(rk, top, None, n, 2 * n, size)]  # drained top
     top_edges = p.boundary_edges[np.all(x[p.boundary_edges][:, :, 1] > height - tol, axis=1)]
-    tb = boundary_rule(x, top_edges)
     f = np.zeros(size)
-    f[1:2 * n:2] = evaluate_moving(rk, tb.points, tb.owner).matrix().T @ (-load * np.abs(tb.normal_length[:, 1]))
+    f[:2 * n] = edge_load(rk, top_edges, lambda xs, normal: [0.0, -load] * np.ones_like(xs))
     axis = np.abs(x[:, 0] - h) < tol
     probe = sp.vstack([collocation_rows(rk, np.flatnonzero(axis & (x[:, 1] > height - tol)), 1, n, 0, size),
                        collocation_rows(rk, np.flatnonzero(axis & (x[:, 1] < tol)), None, n, 2 * n, size)]).tocsr()

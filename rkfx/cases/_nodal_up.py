@@ -5,14 +5,15 @@ nodal rules share.
 of half a spacing), their median-dual areas as square cells, and any rule of
 ``rkfx.integration.nodal_stabilized.RULES``. On a communicator of several ranks the nodes are
 split by RCB: each rank's rule covers its own nodes' cells only, and ``rank_unknowns`` gives
-its local u-p unknowns (own nodes, then the ghosts its rows touch).
+its local u-p unknowns (own nodes, then the ghosts its rows touch). ``edge_load``: the force of
+a traction on boundary edges.
 """
 from typing import NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
 
-from rkfx.approximation.semi_lagrangian import MovingRK, moving_rk
+from rkfx.approximation.semi_lagrangian import MovingRK, evaluate_moving, moving_rk
 from rkfx.geometry.nodal_domains import nodal_domains
 from rkfx.geometry.particles import Particles
 from rkfx.integration.nodal_stabilized import NodalIntegration, boundary_rule, nodal_cells, nodal_integration
@@ -54,3 +55,14 @@ def rank_unknowns(d, constraints: sp.spmatrix, comm) -> LocalUnknowns:
     cols = sp.csr_matrix(constraints).indices
     touched = np.unique(np.r_[d.own, np.where(cols < 2 * n, cols // 2, cols - 2 * n), d.rule.columns()])
     return local_unknowns(d.numbering, touched, (2, 1), comm)
+
+
+def edge_load(rk: MovingRK, edges: np.ndarray, traction) -> np.ndarray:
+    """f_I = int N_I t ds over boundary ``edges`` (node pairs, the domain on their left) by two
+    Gauss points per edge, interleaved, shape ``(2 num_nodes,)``; ``traction(x, n)`` [Pa] takes
+    the points and their outward unit normals, shape ``(m, 2)`` each."""
+    b = boundary_rule(rk.x, edges)
+    w = np.linalg.norm(b.normal_length, axis=1)
+    t = np.asarray(traction(b.points, b.normal_length / w[:, None]), float).reshape(-1, 2)
+    f = evaluate_moving(rk, b.points, b.owner).matrix().T @ (w[:, None] * t)
+    return f.ravel()

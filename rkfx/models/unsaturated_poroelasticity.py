@@ -10,9 +10,12 @@ with rho = (1 - n) rho_s + n S_w rho_w (6.5), 1/Q of (6.7) and the retention law
 Zienkiewicz et al. (1999, eq. 2.9), the transpose of the stress term; (6.16) prints alpha
 alone, which equals it while saturated.
 
-The displacement is measured from a saturated state (S_w = 1, p = 0) in equilibrium with
-gravity (the initial effective stress balances rho_sat g), so only rho - rho_sat = n rho_w
-(S_w - 1) loads the skeleton. The forms are those of ``rkfx.assembly.nodal_forms`` with the
+By default (``weight="change"``) the displacement is measured from a saturated state (S_w = 1,
+p = 0) in equilibrium with gravity (the initial effective stress balances rho_sat g), so only
+rho - rho_sat = n rho_w (S_w - 1) loads the skeleton; with ``weight="full"`` the skeleton
+starts unstressed and carries the whole weight rho(S_w) g, so that sigma'' = D eps(u) is the
+effective stress itself (the initial state of a slope or a levee). A constant external force
+(``load``: tractions, e.g. a reservoir's water on a face) may be added. The forms are those of ``rkfx.assembly.nodal_forms`` with the
 coefficients at the nodes L: S_w, k_rw and 1/Q of p(x_L) = N_I(x_L) p_I. As a model of
 ``rkfx.solvers`` (u and p of time order 1, u quasi-static):
 
@@ -46,6 +49,9 @@ from rkfx.solvers.model import Constraints, Stateless
 
 #: Gravitational acceleration of §6.4.2 [m/s^2].
 GRAVITY = 9.806
+
+#: What the skeleton's body load is: the change of the mixture's weight from saturation, or all of it.
+WEIGHTS = ("change", "full")
 
 
 @dataclass(frozen=True)
@@ -105,10 +111,16 @@ class UnsaturatedBiotModel(Stateless):
             them up). ``None``: the whole model.
         seepage: A seepage face (``rkfx.assembly.seepage_face``): outflow kappa <p>_+ through it
             (with ``local``, the rank's own points over the whole node set).
+        weight: ``"change"`` (the skeleton carries rho - rho_sat) or ``"full"`` (all of rho).
+        load: A constant external force over the whole model's vector (with ``local``, each
+            rank adds its owned entries), or ``None``.
     """
 
     def __init__(self, rule: NodalIntegration, soil: UnsaturatedSoil, constraints: Constraints,
-                 local: LocalUnknowns | None = None, seepage: SeepageFace | None = None):
+                 local: LocalUnknowns | None = None, seepage: SeepageFace | None = None, weight: str = "change",
+                 load: np.ndarray | None = None):
+        if weight not in WEIGHTS:
+            raise InputError(f"weight = {weight!r}: choose {' or '.join(WEIGHTS)}")
         self.local = local
         self.share = None if local is None else local.share
         if local is not None:
@@ -137,6 +149,17 @@ class UnsaturatedBiotModel(Stateless):
             for j, rows in enumerate((rule.trial_x, rule.trial_y)):
                 self.expansion.append((rule.moments[:, j], [rows.matrix(c).tocsr() for c in range(2)]))
         self.g = np.array([0.0, -soil.gravity])
+        m = soil.medium
+        # the skeleton's body load per unit volume is [rho_0 + n rho_w S_w] g
+        self._rho_0 = -m.porosity * m.rho_f if weight == "change" else (1.0 - m.porosity) * m.rho_s
+        whole = 3 * n if local is None else int(local.index.max(initial=-1)) + 1
+        if load is not None and (np.ndim(load) != 1 or len(load) < whole):
+            raise InputError(f"load has shape {np.shape(load)}; give the whole model's force vector")
+        if load is not None and local is not None:
+            owned = np.zeros(len(local.index), bool)
+            owned[local.share.owned] = True
+            load = np.where(owned, np.asarray(load, float)[local.index], 0.0)
+        self._load = None if load is None else np.asarray(load, float)
         self._at = None
         self._forms()
 
@@ -208,7 +231,7 @@ class UnsaturatedBiotModel(Stateless):
         k = m.k * c["kr"]
         grad = [t @ P for t in self.trial]
         r_u = self.K @ u - self.div_test.T @ (V * soil.alpha * c["S"] * pL)
-        body = V * m.porosity * m.rho_f * (c["S"] - 1.0)
+        body = V * (self._rho_0 + m.porosity * m.rho_f * c["S"])
         r_u[1::2] -= self.NT @ (body * self.g[1])
         if self.g[0]:
             r_u[0::2] -= self.NT @ (body * self.g[0])
@@ -223,7 +246,8 @@ class UnsaturatedBiotModel(Stateless):
             face = self._face @ P
             r_p = r_p + self._face.T @ (self.seepage.weights * self.seepage.penalty * np.maximum(face, 0.0))
         self._at = (pL, c, grad, second, face)
-        return np.r_[r_u, r_p]
+        r = np.r_[r_u, r_p]
+        return r if self._load is None else r - self._load
 
     def tangent(self, x: np.ndarray, t: float) -> sp.csr_matrix:
         V, soil = self.V, self.soil

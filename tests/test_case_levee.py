@@ -1,0 +1,57 @@
+"""The levee's initial state (``rkfx.cases.levee``, stage 1): steady seepage under gravity with
+a seepage face, RKPM beside FEM on one gmsh triangulation."""
+import numpy as np
+import pytest
+
+from rkfx.cases import levee
+from rkfx.errors import InputError
+
+
+@pytest.fixture(scope="module")
+def quick():
+    pytest.importorskip("dolfinx_solver")
+    return levee.run(**levee.QUICK)
+
+
+def test_rkpm_and_fem_reach_the_same_steady_seepage(quick):
+    """At h = 0.1 m (measured: p within 0.45 % of the range, u 0.72 %, outflow 0.36 %, the
+    exit on the downstream slope 0.31 / 0.305 m)."""
+    rk, fem = quick.runs
+    assert rk.method == "rkpm-nsni" and fem.method == "fem-taylor-hood"
+    assert rk.errors["p_max"] < 0.01 and rk.errors["u_max"] < 0.02 and rk.errors["outflow"] < 0.01, rk.errors
+    assert rk.errors["exit_height"] <= 0.05 and rk.errors["crest_settlement"] < 0.01, rk.errors
+    for r in (rk, fem):
+        assert r.info["cuts"] == 0 and r.info["steps"] <= 25
+        # water leaves through the lower part of the downstream slope only, and the crest settles
+        assert 0.1 < r.info["exit_height"] < levee.PARAMS["water"].default
+        assert r.info["outflow"] > 0 and r.info["crest_settlement"] > 0
+
+
+def test_the_river_pressure_and_the_dry_crest(quick):
+    """p = gamma_w (water - y) on the wet slope (the upstream toe at 0.8 gamma_w), suction under
+    the crest, p <= 0 on the seepage face."""
+    gamma_w = 1000.0 * 9.806
+    for r in quick.runs:
+        x, y, p = (np.asarray(r.series[k]) for k in ("x", "y", "p"))
+        toe = np.argmin(np.hypot(x, y))
+        assert p[toe] == pytest.approx(0.8 * gamma_w, rel=1e-3)
+        assert p[y > 0.999].max() < -0.1 * gamma_w
+        assert np.asarray(r.series["slope_p"]).max() < 1e-3 * gamma_w
+
+
+def test_the_elastic_state_is_beyond_drucker_prager_in_the_saturated_core(quick):
+    """K0 = nu / (1 - nu) = 0.43 is below Rankine's active ratio for phi = 20 deg: the elastic
+    state exceeds the yield surface where suction does not hold the sand (most of the body,
+    measured 278 of 371 nodes, worst at the downstream toe)."""
+    rk = quick.runs[0]
+    ratio = np.asarray(rk.series["strength"])
+    assert rk.info["yielded_nodes"] == int(np.sum(ratio >= 1.0)) > len(ratio) // 2
+    assert rk.info["strength_max_x"] > 3.5 and rk.info["strength_max_y"] < 0.2
+
+
+def test_bad_parameters_are_refused_in_one_line():
+    prm = {k: v.default for k, v in levee.PARAMS.items()}
+    for bad, match in ((dict(water=1.2), "water"), (dict(h=0.3), "too coarse"), (dict(rule="gauss"), "rule"),
+                       (dict(conductivity=0.0), "conductivity"), (dict(S_rw=1.5), "S_rw")):
+        with pytest.raises(InputError, match=match):
+            levee.check(**{**prm, **bad})
