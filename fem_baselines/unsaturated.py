@@ -31,6 +31,7 @@ import ufl
 
 from fem_baselines.elasticity import strain, stress_law
 from fem_baselines.poroelasticity import FemBiotModel, _global_matrix, _global_vector
+from rkfx.assembly.seepage_face import check_penalty
 from rkfx.conditions import Condition
 from rkfx.errors import InputError
 from rkfx.models.unsaturated_poroelasticity import WEIGHTS, UnsaturatedSoil
@@ -100,9 +101,7 @@ class FemUnsaturatedModel(FemBiotModel):
         self._face = None
         if seepage is not None:
             part, kappa = seepage
-            if not (np.isfinite(kappa) and kappa > 0):
-                raise InputError(f"seepage face penalty = {kappa!r} must be a positive outflow per unit pressure "
-                                 "[m/(Pa s)], e.g. 1e3 k / h")
+            check_penalty(kappa)
             ds = ufl.Measure("ds", domain=mesh, subdomain_data=self.boundary.tags([part], "seepage face"))(1)
             wet = ufl.conditional(ufl.gt(p, 0.0), 1.0, 0.0)
             outflow = const(kappa) * ufl.max_value(p, 0.0)

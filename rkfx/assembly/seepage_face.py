@@ -27,6 +27,13 @@ from rkfx.errors import InputError
 from rkfx.integration.nodal_stabilized import boundary_rule
 
 
+def check_penalty(kappa: float) -> None:
+    """Raise InputError unless ``kappa`` is a positive outflow per unit pressure."""
+    if not (np.isfinite(kappa) and kappa > 0):
+        raise InputError(f"seepage face penalty = {kappa!r} must be a positive outflow per unit pressure "
+                         "[m/(Pa s)], e.g. 1e3 k / h")
+
+
 @dataclass(frozen=True)
 class SeepageFace:
     """The points of a seepage face and its penalty.
@@ -44,9 +51,7 @@ class SeepageFace:
     penalty: float
 
     def __post_init__(self):
-        if not (np.isfinite(self.penalty) and self.penalty > 0):
-            raise InputError(f"seepage face penalty = {self.penalty!r} must be a positive outflow per unit "
-                             "pressure [m/(Pa s)], e.g. 1e3 k / h")
+        check_penalty(self.penalty)
 
     def localized(self, nodes: np.ndarray) -> "SeepageFace":
         """The same face over the local nodes ``nodes`` (as ``NodalIntegration.localized``)."""

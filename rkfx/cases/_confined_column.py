@@ -8,7 +8,8 @@ base fixed in y and impermeable, the top drained (p = 0) and loaded by a compres
 q from t = 0.
 
 On a communicator of several ranks the nodes are split by RCB: each rank's rule covers its own
-nodes' cells only, and ``rkfx.cases._nodal_up.rank_unknowns`` gives its local unknowns (own nodes, then ghosts).
+nodes' cells only, and ``rkfx.cases._nodal_up.rank_unknowns`` gives its local unknowns (own
+nodes, then ghosts).
 """
 from collections.abc import Callable
 from typing import NamedTuple

@@ -15,11 +15,13 @@ p = 0) in equilibrium with gravity (the initial effective stress balances rho_sa
 rho - rho_sat = n rho_w (S_w - 1) loads the skeleton; with ``weight="full"`` the skeleton
 starts unstressed and carries the whole weight rho(S_w) g, so that sigma'' = D eps(u) is the
 effective stress itself (the initial state of a slope or a levee). A constant external force
-(``load``: tractions, e.g. a reservoir's water on a face) may be added. The forms are those of ``rkfx.assembly.nodal_forms`` with the
+f (``load``: tractions, e.g. a reservoir's water on a face) may be added, and a seepage face
+(``seepage``) adds its one-sided outflow F(p) = N_face^T (w kappa <N_face p>_+)
+(``rkfx.assembly.seepage_face``). The forms are those of ``rkfx.assembly.nodal_forms`` with the
 coefficients at the nodes L: S_w, k_rw and 1/Q of p(x_L) = N_I(x_L) p_I. As a model of
 ``rkfx.solvers`` (u and p of time order 1, u quasi-static):
 
-    r = [K u - C(S) p - f_g(S),  A(k_rw) p - G(k_rw S)]
+    r = [K u - C(S) p - f_g(S) - f,  A(k_rw) p - G(k_rw S) + F(p)]
     c(x, v) = [0,  D(S) u' + M(1/Q) p']                           (``rate_force``)
 
 K = sum V B^c^T D B, C(S) = sum V alpha S (B^c)^T m N, D(S) = sum V alpha S N^T m^T B,
