@@ -285,6 +285,18 @@ class _Sampler:
         vals[self.missing] = np.nan
         return vals[:, gdim].copy(), vals[:, :gdim].copy()
 
+    def field(self, f: dolfinx.fem.Function) -> np.ndarray:
+        """Any Function's values at the points, shape ``(m, value size)`` (NaN where no cell holds
+        a point); on a cell boundary a discontinuous field takes the value of one of its cells."""
+        size = int(np.prod(f.function_space.value_shape, dtype=int))
+        vals = np.zeros((self.x3.shape[0], size), dtype=np.float64)
+        if np.any(self.mine):
+            vals[self.mine] = f.eval(self.x3[self.mine], self.cells).reshape(-1, size)
+        if self.comm.size > 1:
+            self.comm.Allreduce(MPI.IN_PLACE, vals, op=MPI.SUM)
+        vals[self.missing] = np.nan
+        return vals
+
 
 # --------------------------------------------------------------------------- the model
 

@@ -14,11 +14,13 @@ def quick():
 
 
 def test_rkpm_and_fem_reach_the_same_steady_seepage(quick):
-    """At h = 0.1 m (measured: p within 0.45 % of the range, u 0.72 %, outflow 0.36 %, the
-    exit on the downstream slope 0.31 / 0.305 m)."""
+    """At h = 0.1 m (measured: p within 0.45 % of the range, u 0.72 %, the effective stress
+    0.73 % rms and 4.0 % at most over the interior nodes, outflow 0.36 %, the exit on the
+    downstream slope 0.31 / 0.305 m)."""
     rk, fem = quick.runs
     assert rk.method == "rkpm-nsni" and fem.method == "fem-taylor-hood"
     assert rk.errors["p_max"] < 0.01 and rk.errors["u_max"] < 0.02 and rk.errors["outflow"] < 0.01, rk.errors
+    assert rk.errors["stress_rms"] < 0.015 and rk.errors["stress_interior"] < 0.08, rk.errors
     assert rk.errors["exit_height"] <= 0.05 and rk.errors["crest_settlement"] < 0.01, rk.errors
     for r in (rk, fem):
         assert r.info["cuts"] == 0 and r.info["steps"] <= 25
@@ -42,11 +44,11 @@ def test_the_river_pressure_and_the_dry_crest(quick):
 def test_the_elastic_state_is_beyond_drucker_prager_in_the_saturated_core(quick):
     """K0 = nu / (1 - nu) = 0.43 is below Rankine's active ratio for phi = 20 deg: the elastic
     state exceeds the yield surface where suction does not hold the sand (most of the body,
-    measured 278 of 371 nodes, worst at the downstream toe)."""
-    rk = quick.runs[0]
-    ratio = np.asarray(rk.series["strength"])
-    assert rk.info["yielded_nodes"] == int(np.sum(ratio >= 1.0)) > len(ratio) // 2
-    assert rk.info["strength_max_x"] > 3.5 and rk.info["strength_max_y"] < 0.2
+    measured 278 of 371 nodes by RKPM, 286 by FEM, worst at the downstream toe)."""
+    for r in quick.runs:
+        ratio = np.asarray(r.series["strength"])
+        assert r.info["yielded_nodes"] == int(np.sum(ratio >= 1.0)) > len(ratio) // 2
+        assert r.info["strength_max_x"] > 3.5 and r.info["strength_max_y"] < 0.2
 
 
 def test_bad_parameters_are_refused_in_one_line():
