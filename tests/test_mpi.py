@@ -71,6 +71,18 @@ def test_quick_runs_on_ranks_are_the_serial_run(tmp_path, case, ranks):
     every series within 1e-10 of its largest value (the
     early-time overshoots are round-off sized themselves: compared absolutely), the same Newton
     iterations and steps."""
+    _quick_run_on_ranks(tmp_path, case, ranks)
+
+
+@pytest.mark.mpi
+@pytest.mark.skipif(not MPIEXEC.exists() and shutil.which("mpiexec") is None, reason="no mpiexec")
+def test_levee_split_along_its_wet_slope_is_the_serial_run(tmp_path):
+    """On 4 ranks RCB cuts the river's wet slope: the river's load must reach every owner
+    (formed whole on each rank, added at the owned entries) for the serial run's fields."""
+    _quick_run_on_ranks(tmp_path, "levee", 4)
+
+
+def _quick_run_on_ranks(tmp_path, case: str, ranks: int) -> None:
     import json
 
     mpiexec = str(MPIEXEC) if MPIEXEC.exists() else "mpiexec"

@@ -215,10 +215,8 @@ def rkpm_levee(p, soil: UnsaturatedSoil, levee: Levee, h: float, rule: str, poin
     edges = p.boundary_edges
     face = seepage_face(d.rk, edges[p.boundary_tags == p.tag("downstream")], PENALTY * soil.medium.k / h, nodes=d.own)
     wet_edges = edges[p.boundary_tags == p.tag("upstream_wet")]
-    if d.own is not None:  # each rank loads the segments whose first node it owns
-        wet_edges = wet_edges[np.isin(wet_edges[:, 0], d.own)]
-    load = np.zeros(size)
-    load[:2 * n] = edge_load(d.rk, wet_edges, lambda xs, normal: -river(xs)[:, None] * normal) if len(wet_edges) else 0.0
+    load = np.zeros(size)  # the whole force on every rank; the model keeps the rank's owned entries
+    load[:2 * n] = edge_load(d.rk, wet_edges, lambda xs, normal: -river(xs)[:, None] * normal)
     nearest = cKDTree(x).query(points)[1]
     rows = evaluate_moving(d.rk, points, nearest).matrix().tocsr()
     rows = sp.vstack([placed(rows, size, 2 * n), placed(rows, size, 0, 2), placed(rows, size, 1, 2)]).tocsr()
