@@ -488,13 +488,13 @@ def plot(results: Results, out: Path) -> list[Path]:
 
 
 CLAIMS = [
-    Claim("Initial state: RKPM's steady pressure within 2 % of the FEM baseline's (of the pressure range)",
+    Claim("Fig 6.10, initial state: RKPM's steady pressure within 2 % of the FEM baseline's (of the pressure range)",
           run="rkpm-nsni", key="p_max", op="<", bound=0.02),
-    Claim("Initial state: RKPM's seepage outflow within 2 % of the FEM baseline's",
+    Claim("Fig 6.10, initial state: RKPM's seepage outflow within 2 % of the FEM baseline's",
           run="rkpm-nsni", key="outflow", op="<", bound=0.02),
-    Claim("Initial state: RKPM's displacement within 5 % of the FEM baseline's (of its largest)",
+    Claim("Fig 6.10, initial state: RKPM's displacement within 5 % of the FEM baseline's (of its largest)",
           run="rkpm-nsni", key="u_max", op="<", bound=0.05),
-    Claim("Initial state: RKPM's effective stress within 2 % rms of the FEM baseline's (interior nodes)",
+    Claim("Fig 6.10, initial state: RKPM's effective stress within 2 % rms of the FEM baseline's (interior nodes)",
           run="rkpm-nsni", key="stress_rms", op="<", bound=0.02),
 ]
 
