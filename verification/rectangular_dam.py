@@ -113,17 +113,16 @@ def rkpm_dam(soil: UnsaturatedSoil, dam: Dam, ny: int, comm=None, rule: str = "n
     points (``model.share``)."""
     from rkfx.assembly.seepage_face import seepage_face  # noqa: PLC0415
     from rkfx.cases._confined_column import column_discretization  # noqa: PLC0415
-    from rkfx.cases._nodal_up import rank_unknowns  # noqa: PLC0415
+    from rkfx.cases._nodal_up import owned, rank_unknowns  # noqa: PLC0415
 
     nx = int(round((ny - 1) * dam.length / dam.height)) + 1
     d = column_discretization(dam.length, dam.height, nx, ny, rule, comm=comm)
     x, n = d.particles.x, d.particles.num_nodes
     size = 3 * n
-    mine = (lambda nodes: np.intersect1d(nodes, d.own)) if d.own is not None else (lambda nodes: nodes)
-    base = mine(d.bottom)
-    up = mine(np.flatnonzero(dam.on_face(x, down=False)))
+    base = owned(d, d.bottom)
+    up = owned(d, np.flatnonzero(dam.on_face(x, down=False)))
     down = np.flatnonzero(dam.on_face(x, down=True, wet=True if dam.seepage else None))
-    down = mine(down[:0] if dam.seepage and dam.head_down <= 0.0 else down)  # no tailwater: the whole face seeps
+    down = owned(d, down[:0] if dam.seepage and dam.head_down <= 0.0 else down)  # no tailwater: the whole face seeps
     p_up, p_down = heads(dam, soil.medium.rho_f * soil.gravity)
     G = sp.vstack([collocation_rows(d.rk, base, 0, n, 0, size), collocation_rows(d.rk, base, 1, n, 0, size),
                    collocation_rows(d.rk, up, None, n, 2 * n, size),

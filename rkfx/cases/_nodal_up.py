@@ -5,7 +5,8 @@ nodal rules share.
 of half a spacing), their median-dual areas as square cells, and any rule of
 ``rkfx.integration.nodal_stabilized.RULES``. On a communicator of several ranks the nodes are
 split by RCB: each rank's rule covers its own nodes' cells only, and ``rank_unknowns`` gives
-its local u-p unknowns (own nodes, then the ghosts its rows touch). ``edge_load``: the force of
+its local u-p unknowns (own nodes, then the ghosts its rows touch), ``owned`` the rank's share
+of a node set and ``whole_unknowns`` a model's size over all ranks. ``edge_load``: the force of
 a traction on boundary edges.
 """
 from typing import NamedTuple
@@ -45,6 +46,17 @@ def nodal_discretization(p: Particles, spacing: float, rule: str = "nsni", comm=
         own = np.sort(num.old_of_new[num.ranges[comm.rank]:num.ranges[comm.rank + 1]])
     r = nodal_integration(rk, cells, boundary_rule(p.x, p.boundary_edges), rule, points=own)
     return NodalDiscretization(p, rk, r, own, num)
+
+
+def owned(d, nodes: np.ndarray) -> np.ndarray:
+    """The nodes of ``nodes`` the rank owns (all of them when serial): where it collocates."""
+    return nodes if d.own is None else np.intersect1d(nodes, d.own)
+
+
+def whole_unknowns(model) -> int:
+    """A model's unknowns over all ranks (a distributed model counts its owned ones)."""
+    share = getattr(model, "share", None)
+    return model.layout.size if share is None else int(round(share.total(share.num_owned)))
 
 
 def rank_unknowns(d, constraints: sp.spmatrix, comm) -> LocalUnknowns:

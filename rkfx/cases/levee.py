@@ -66,11 +66,12 @@ import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 from rkfx.approximation.semi_lagrangian import evaluate_moving
+from rkfx.assembly.operators import strain_matrix
 from rkfx.assembly.seepage_face import seepage_face
 from rkfx.assembly.weighted_forms import placed
 from rkfx.cases import _cli, _preflight
 from rkfx.cases._cli import Param, Results, Run
-from rkfx.cases._nodal_up import edge_load, nodal_discretization, rank_unknowns
+from rkfx.cases._nodal_up import edge_load, nodal_discretization, owned, rank_unknowns, whole_unknowns
 from rkfx.errors import InputError
 from rkfx.integration.nodal_stabilized import RULES
 from rkfx.materials.drucker_prager import DruckerPrager, invariants
@@ -206,8 +207,7 @@ def rkpm_levee(p, soil: UnsaturatedSoil, levee: Levee, h: float, rule: str, poin
     d = nodal_discretization(p, h, rule, comm)
     n, x = p.num_nodes, p.x
     size = 3 * n
-    mine = (lambda nodes: np.intersect1d(nodes, d.own)) if d.own is not None else (lambda nodes: nodes)
-    base, wet = mine(p.boundary_nodes("base")), mine(p.boundary_nodes("upstream_wet"))
+    base, wet = owned(d, p.boundary_nodes("base")), owned(d, p.boundary_nodes("upstream_wet"))
     river = levee.river(soil.medium.rho_f * soil.gravity)
     G = sp.vstack([collocation_rows(d.rk, base, 0, n, 0, size), collocation_rows(d.rk, base, 1, n, 0, size),
                    collocation_rows(d.rk, wet, None, n, 2 * n, size)]).tocsr()
@@ -273,9 +273,7 @@ def fem_levee(mesh_data, soil: UnsaturatedSoil, levee: Levee, h: float, points: 
 
 def _rkpm_strains(model, x: np.ndarray) -> np.ndarray:
     """(eps_xx, eps_yy, gamma_xy) of RKPM at its integration points, by the rule's trial gradients."""
-    u = x[:2 * model.n]
-    return np.column_stack([model.trial[0] @ u[0::2], model.trial[1] @ u[1::2],
-                            model.trial[1] @ u[0::2] + model.trial[0] @ u[1::2]])
+    return (strain_matrix(model.rule.trial) @ x[:2 * model.n]).reshape(-1, 3)
 
 
 def _strength(strains: np.ndarray, soil: UnsaturatedSoil, phi: float, cohesion: float):
@@ -364,9 +362,7 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.3, rho_s=2700
             info.update(strength_max=float(ratio.max()), strength_max_x=float(p.x[worst, 0]),
                         strength_max_y=float(p.x[worst, 1]), yielded_nodes=int(np.sum(ratio >= 1.0)))
             found[method] = (pv[:n], ux[:n], uy[:n], stress)
-            size = model.layout.size if getattr(model, "share", None) is None else \
-                int(round(model.share.total(model.share.num_owned)))
-            results.runs.append(Run(label, time.perf_counter() - t0, size, series=series, info=info))
+            results.runs.append(Run(label, time.perf_counter() - t0, whole_unknowns(model), series=series, info=info))
         if rank == 0:
             gmsh.model.remove()
     finally:

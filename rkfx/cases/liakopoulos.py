@@ -75,7 +75,7 @@ from rkfx.assembly.weighted_forms import placed
 from rkfx.cases import _cli, _preflight
 from rkfx.cases._cli import Param, Results, Run
 from rkfx.cases._confined_column import column_discretization
-from rkfx.cases._nodal_up import rank_unknowns
+from rkfx.cases._nodal_up import owned, rank_unknowns, whole_unknowns
 from rkfx.conditions import Displacement, Pressure
 from rkfx.errors import InputError
 from rkfx.integration.nodal_stabilized import RULES
@@ -197,10 +197,9 @@ def rkpm_column(soil, W, L, ny, rule, points, comm=None):
     n = d.particles.num_nodes
     size = 3 * n
     ranks = d.own is not None  # each rank integrates over its own nodes' cells, collocates at its own nodes
-    own = (lambda nodes: np.intersect1d(nodes, d.own)) if ranks else (lambda nodes: nodes)
-    G = sp.vstack([collocation_rows(d.rk, own(d.bottom), 1, n, 0, size),
-                   collocation_rows(d.rk, own(d.sides), 0, n, 0, size),
-                   collocation_rows(d.rk, own(d.bottom), None, n, 2 * n, size)]).tocsr()
+    G = sp.vstack([collocation_rows(d.rk, owned(d, d.bottom), 1, n, 0, size),
+                   collocation_rows(d.rk, owned(d, d.sides), 0, n, 0, size),
+                   collocation_rows(d.rk, owned(d, d.bottom), None, n, 2 * n, size)]).tocsr()
     nearest = cKDTree(d.particles.x).query(points)[1]
     rows = evaluate_moving(d.rk, points, nearest).matrix().tocsr()
     # [p at the points..., u_y at the last one] over the whole vector
@@ -215,12 +214,6 @@ def rkpm_column(soil, W, L, ny, rule, points, comm=None):
     return UnsaturatedBiotModel(d.rule, soil, Constraints(G, np.zeros(G.shape[0])), local), sample
 
 
-def _unknowns(model) -> int:
-    """The whole model's unknowns (an RKPM model on ranks counts its owned ones over all ranks)."""
-    share = getattr(model, "share", None)
-    return model.layout.size if share is None else int(round(share.total(share.num_owned)))
-
-
 def _rkpm(soil, W, L, ny, rule, times, points, io):
     t0 = time.perf_counter()
     comm = _cli.comm()
@@ -229,7 +222,7 @@ def _rkpm(soil, W, L, ny, rule, times, points, io):
     st = backward_euler()
     out = integrate(st, model, times, start=st.start(model), recorder=rec, comm=comm,
                     progress=lambda it: _cli.progress(it, f"rkpm-{rule} ny={ny}", len(times) - 1), **io)
-    return rec, time.perf_counter() - t0, {"unknowns": _unknowns(model), "newton_iterations": out.newton_iterations, "cuts": out.cuts,
+    return rec, time.perf_counter() - t0, {"unknowns": whole_unknowns(model), "newton_iterations": out.newton_iterations, "cuts": out.cuts,
                                            "steps": len(times) - 1}
 
 
@@ -348,7 +341,7 @@ def _steady_study(results: Results, soil: UnsaturatedSoil, methods, W, L, ny, re
         values = sample(done.state.x)
         p_exact = np.interp(ys, exact.y, exact.p)
         scale = abs(exact.p[-1])
-        results.runs.append(Run(label, time.perf_counter() - t0, _unknowns(model),
+        results.runs.append(Run(label, time.perf_counter() - t0, whole_unknowns(model),
                                 series={"y": ys, "p": values[:-1], "p_exact": p_exact},
                                 errors={"p_max": float(np.abs(values[:-1] - p_exact).max() / scale),
                                         "settlement": float(abs(values[-1] - exact.top_displacement)
