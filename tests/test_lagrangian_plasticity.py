@@ -105,6 +105,15 @@ def test_resume_continues_the_run(tmp_path):
     assert np.allclose(second.x, whole.x, rtol=0, atol=1e-14)
 
 
+def test_a_checkpoint_without_sheet_counts_restores():
+    """States written before sheet rows were counted hold a one-element counter."""
+    _, model, _ = _block(5, 5)
+    arrays = dict(model.state()) | {"torn": np.array([7], np.int64)}
+    model.restore(arrays)
+    counts = model.neighbour_rebuilds
+    assert (counts["torn_point_evaluations"], counts["sheet_point_evaluations"]) == (7, 0)
+
+
 def test_wall_friction_caps_at_coulomb():
     floor = Wall((0, 0), (0, 1), 0.5, "floor")
     x = np.array([[0.0, -1e-4], [0.0, -1e-4], [0.0, 1e-3]])

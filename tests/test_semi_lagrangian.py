@@ -104,15 +104,45 @@ def test_bad_parameters_are_named(kw, word):
         moving_rk(p.x, **args)
 
 
-def test_torn_points_get_shepard_rows_when_counted():
-    """Collinear neighbours: a singular moment matrix raises, or gives the constant-basis row."""
-    x = np.array([[0.0, 0.0], [0.1, 0.0], [0.2, 0.0], [0.3, 0.0]])
+def test_torn_points_get_sheet_or_shepard_rows_when_counted():
+    """Collinear neighbours: a singular moment matrix raises, or, with a counter, gives the row
+    along the line; a lone point gets the constant-basis (Shepard) row."""
+    x = np.array([[0.0, 0.0], [0.1, 0.0], [0.2, 0.0], [0.3, 0.0], [2.0, 0.0]])
     with pytest.raises(SingularMomentMatrix):
         evaluate_moving(moving_rk(x, 0.25, 0.02), gradients=True)
-    counter = np.zeros(1, np.int64)
+    counter = np.zeros(2, np.int64)
     rows = evaluate_moving(moving_rk(x, 0.25, 0.02, torn=counter), gradients=True)
-    assert counter[0] == 4
+    assert counter.tolist() == [1, 4]
     assert np.allclose(rows.matrix(0).sum(axis=1).A.ravel(), 1.0)
-    assert np.array_equal(rows.data[:, 1:], np.zeros_like(rows.data[:, 1:]))
+    v = rows @ x
+    assert np.allclose(v[:4, 0, 0], x[:4, 0], atol=1e-14) and np.allclose(v[:4, 1, 0], 1.0, atol=1e-12)
+    assert np.allclose(v[:, 2], 0.0, atol=1e-14) and v[4, 1, 0] == 0.0  # nothing across the line; the lone point
     with pytest.raises(InputError, match="counter"):
-        moving_rk(x, 0.25, 0.02, torn=[0])
+        moving_rk(x, 0.25, 0.02, torn=np.zeros(1, np.int64))
+
+
+@pytest.mark.parametrize("angle", [0.0, 0.5, np.pi / 2])
+def test_a_sheet_along_any_direction_gets_rows_along_it(angle):
+    """Grains in a line with offsets of 1e-4 h across it (a toe sliding on a floor): the moment
+    matrix scaled by its diagonal is far from singular along an axis, yet its gradients across
+    the line would be ~1e4 / h; the sheet rows reproduce linear fields along the line (to the
+    offsets) with gradients along it only, in any orientation. A grid is left as it was."""
+    rng = np.random.default_rng(3)
+    t, n = np.array([np.cos(angle), np.sin(angle)]), np.array([-np.sin(angle), np.cos(angle)])
+    s, e = np.linspace(0.0, 1.0, 11), 1e-5 * rng.standard_normal(11)
+    x = s[:, None] * t + e[:, None] * n
+    counter = np.zeros(2, np.int64)
+    for kw in ({}, {"gradients": True}, {"implicit": True}, {"second": True}):
+        rows = evaluate_moving(moving_rk(x, 0.25, 0.02, torn=counter), **kw)
+        v = rows @ (x @ t)  # the coordinate along the line
+        assert np.allclose(v[:, 0], s, atol=1e-4)
+        if kw:
+            assert np.allclose(v[:, 1:3], t, atol=1e-3)  # along the offsets' principal direction
+            assert np.abs(rows @ (x @ n)[:, None])[:, 1:3].max() < 1e-3  # not 1e4 / h
+        if "second" in kw:
+            assert np.array_equal(rows.data[:, 3:], np.zeros_like(rows.data[:, 3:]))
+    assert counter.tolist() == [0, 44]
+    p = structured(1.0, 1.0, 11, 11)
+    counted = evaluate_moving(moving_rk(p.x, 0.2, 0.02, torn=counter), second=True)
+    assert counter.tolist() == [0, 44]
+    assert np.array_equal(counted.data, evaluate_moving(moving_rk(p.x, 0.2, 0.02), second=True).data)

@@ -21,7 +21,7 @@ import numpy as np
 
 from rkfx.approximation.kernel import cubic_spline
 from rkfx.approximation.neighbours import CHUNK, support_neighbours
-from rkfx.approximation.shape_functions import DIRECT, IMPLICIT, RCOND_MIN, SECOND, VALUES, linear_row
+from rkfx.approximation.shape_functions import DIRECT, IMPLICIT, RCOND_MIN, SECOND, VALUES, linear_row, moments
 from rkfx.approximation.sparse_rows import SparseRows
 from rkfx.errors import InputError, SingularMomentMatrix, point_str
 
@@ -40,12 +40,16 @@ class MovingRK:
         reach: Largest distance of an evaluation point from the node whose row it uses [m].
         searched: Rows searched when this state was made (all of them for a new one).
         torn: ``None``: a point whose moment matrix is singular (too few or collinear
-            neighbours) raises ``SingularMomentMatrix``. Otherwise a one-element int64 counter:
-            such a point, and one whose scaled moment matrix has a reciprocal condition below
-            ``TORN_RCOND``, gets the constant-basis (Shepard) row instead, N_I = phi_I / sum phi
-            with zero gradients, and the counter grows by one. This is the choice for a
-            cohesionless material whose grains may leave the bulk: a torn-off particle then
-            carries no strain and flies until it rejoins neighbours.
+            neighbours) raises ``SingularMomentMatrix``. Otherwise a two-element int64 counter
+            [Shepard rows, sheet rows] for a cohesionless material whose grains may leave the
+            bulk. A point whose neighbours lie nearly on a line (their kernel-weighted spread
+            across it below ``SHEET_SPREAD``: a sheet of grains, e.g. the toe of a flow along
+            a floor) gets the one-dimensional row along that line, which reproduces linear
+            fields along it and has gradients along it only (``_sheet_row``); a point with too
+            few neighbours even for that, or whose scaled moment matrix has a reciprocal
+            condition below ``TORN_RCOND``, gets the constant-basis (Shepard) row N_I =
+            phi_I / sum phi with zero gradients: a torn-off particle carries no strain and
+            flies until it rejoins neighbours. Each such row adds one to its counter.
     """
 
     x: np.ndarray
@@ -78,8 +82,8 @@ def moving_rk(x: np.ndarray, support: np.ndarray, skin: float, reach: float = 0.
             0.5 of the nodal spacing).
         reach: Farthest evaluation point from its node [m] (0 when shape functions are needed at
             the nodes only; the half-diagonal of a smoothing cell for SNNI).
-        torn: ``None`` to raise at singular points, or a one-element int64 counter for the
-            Shepard rows of torn-off points (see ``MovingRK``).
+        torn: ``None`` to raise at singular points, or a two-element int64 counter for the
+            Shepard and the sheet rows of torn-off points (see ``MovingRK``).
     """
     x = np.ascontiguousarray(x, dtype=np.float64)
     if x.ndim != 2 or x.shape[1] != 2:
@@ -92,8 +96,8 @@ def moving_rk(x: np.ndarray, support: np.ndarray, skin: float, reach: float = 0.
     if not (np.isfinite(reach) and reach >= 0):
         raise InputError(f"reach = {reach!r}: must be a length >= 0")
     indptr, indices = support_neighbours(x, _search_radius(support, skin, reach), x)
-    if torn is not None and (not isinstance(torn, np.ndarray) or torn.shape != (1,) or torn.dtype != np.int64):
-        raise InputError("torn must be None or a one-element int64 counter, np.zeros(1, np.int64)")
+    if torn is not None and (not isinstance(torn, np.ndarray) or torn.shape != (2,) or torn.dtype != np.int64):
+        raise InputError("torn must be None or a two-element int64 counter, np.zeros(2, np.int64)")
     return MovingRK(x, support, x.copy(), indptr, indices, float(skin), float(reach), len(x), torn)
 
 
@@ -192,6 +196,69 @@ def _count_listed(x, a, points, owner, cand_ptr, cand_idx, counts):
 #: inside out in one step long before the matrix is singular to round-off.
 TORN_RCOND = 1e-4
 
+#: With a ``torn`` counter, the smallest kernel-weighted variance of a point's neighbour offsets,
+#: in units of the median support squared, below which they form a sheet. The reciprocal
+#: condition above is scaled by the diagonal and misses a sheet along x or y (a toe sliding on a
+#: floor: 7 particles on a line with offsets of 1e-3 h across it give it 5e-3); on a grid at
+#: a = 2h the variance is 0.080 inside, 0.038 at edges and corners, 1.5e-10 on that line.
+SHEET_SPREAD = 5e-3
+
+
+@numba.njit(inline="always")
+def _spread(n, dxs, dys, phis):
+    """The smallest kernel-weighted variance of the (scaled) offsets and the unit direction
+    (tx, ty) of the largest: a sheet's spread across it and its direction along it."""
+    m0, mx, my, mxx, mxy, myy = moments(n, dxs, dys, phis)
+    if not m0 > 0.0:
+        return 0.0, 1.0, 0.0
+    cxx = mxx / m0 - (mx / m0) ** 2
+    cyy = myy / m0 - (my / m0) ** 2
+    cxy = mxy / m0 - (mx / m0) * (my / m0)
+    mid = 0.5 * (cxx + cyy)
+    half = np.sqrt(max(0.0, 0.25 * (cxx - cyy) ** 2 + cxy * cxy))
+    if abs(cxy) > 0.0:
+        tx, ty = cxy, mid + half - cxx
+    elif cxx >= cyy:
+        tx, ty = 1.0, 0.0
+    else:
+        tx, ty = 0.0, 1.0
+    norm = np.sqrt(tx * tx + ty * ty)
+    return mid - half, tx / norm, ty / norm
+
+
+@numba.njit(inline="always")
+def _sheet_row(n, idx, dxs, dys, phis, tx, ty, inv, base, indices, out):
+    """The row of a sheet point along the unit direction (tx, ty), written at ``base``; False
+    when its neighbours are too few even for that.
+
+    Basis [1, s] with s the offset along t: N_k = (b0 + b1 s_k) phi_k reproduces constants and
+    linear fields along t, and the gradient rows t (g0 + g1 s_k) phi_k (the implicit gradient
+    (6.29) along t) reproduce d/dt; the derivatives of the gradients (``SECOND``) are zero: no
+    second-gradient stabilization there.
+    """
+    a0 = a1 = a2 = 0.0
+    for k in range(n):
+        s = dxs[k] * tx + dys[k] * ty
+        a0 += phis[k]
+        a1 += phis[k] * s
+        a2 += phis[k] * s * s
+    det = a0 * a2 - a1 * a1
+    if not det > 1e-6 * SHEET_SPREAD * a0 * a0:
+        return False
+    b0, b1 = a2 / det, -a1 / det
+    g0, g1 = inv * a1 / det, -inv * a0 / det
+    for k in range(n):
+        s = dxs[k] * tx + dys[k] * ty
+        indices[base + k] = idx[k]
+        out[base + k, 0] = (b0 + b1 * s) * phis[k]
+        if out.shape[1] > 1:
+            g = (g0 + g1 * s) * phis[k]
+            out[base + k, 1] = tx * g
+            out[base + k, 2] = ty * g
+            for c in range(3, out.shape[1]):
+                out[base + k, c] = 0.0
+    return True
+
 
 @numba.njit(inline="always")
 def _shepard_row(n, idx, phis, base, indices, out):
@@ -221,9 +288,16 @@ def _rows_listed(x, a, points, owner, scale, cand_ptr, cand_idx, indptr, kmax, m
             n = _gather_listed(points[p, 0], points[p, 1], x, a, cand_idx, cand_ptr[o], cand_ptr[o + 1],
                                idx, dxs, dys, phis, dphis, inv)
             ratio[p] = linear_row(n, idx, dxs, dys, phis, dphis, inv, mode, indptr[p], indices, out)
-            if shepard > 0.0 and not ratio[p] >= shepard and n > 0:
-                _shepard_row(n, idx, phis, indptr[p], indices, out)
-                ratio[p] = -1.0
+            if shepard > 0.0 and n > 0:
+                across, tx, ty = _spread(n, dxs, dys, phis)
+                if across < SHEET_SPREAD:
+                    if _sheet_row(n, idx, dxs, dys, phis, tx, ty, inv, indptr[p], indices, out):
+                        ratio[p] = -2.0
+                    else:
+                        ratio[p] = 0.0
+                if not (ratio[p] >= shepard or ratio[p] == -2.0):
+                    _shepard_row(n, idx, phis, indptr[p], indices, out)
+                    ratio[p] = -1.0
 
 
 def evaluate_moving(rk: MovingRK, points: np.ndarray | None = None, owner: np.ndarray | None = None,
@@ -273,8 +347,8 @@ def evaluate_moving(rk: MovingRK, points: np.ndarray | None = None, owner: np.nd
     _rows_listed(rk.x, rk.support, points, owner, scale, rk.indptr, rk.indices, indptr, kmax, mode,
                  indices, out, ratio, TORN_RCOND if rk.torn is not None else 0.0)
     if rk.torn is not None:
-        rk.torn[0] += int(np.count_nonzero(ratio == -1.0))
-    bad = np.flatnonzero(~((ratio >= RCOND_MIN) | ((ratio == -1.0) & (rk.torn is not None))))
+        rk.torn[:] += [np.count_nonzero(ratio == -1.0), np.count_nonzero(ratio == -2.0)]
+    bad = np.flatnonzero(~((ratio >= RCOND_MIN) | ((ratio < 0.0) & (rk.torn is not None))))
     if bad.size:
         p = bad[0]
         raise SingularMomentMatrix(

@@ -186,12 +186,9 @@ VALUES, DIRECT, IMPLICIT, SECOND = 0, 1, 2, 3
 
 
 @numba.njit(inline="always")
-def linear_row(n, idx, dxs, dys, phis, dphis, inv, mode, base, indices, out):
-    """One point's linear-basis RK entries from its gathered neighbours, written at ``base``.
-
-    The 3 x 3 moment matrix is inverted by cofactors. Returns det(A) / prod(diag(A)) (0 when A
-    is singular, and nothing is written then).
-    """
+def moments(n, dxs, dys, phis):
+    """The distinct entries m00, m01, m02, m11, m12, m22 of the linear-basis moment matrix
+    sum_k phi_k [1, dx_k, dy_k] x [1, dx_k, dy_k] of gathered neighbours."""
     m00 = m01 = m02 = m11 = m12 = m22 = 0.0
     for k in range(n):
         f = phis[k]
@@ -201,6 +198,17 @@ def linear_row(n, idx, dxs, dys, phis, dphis, inv, mode, base, indices, out):
         m11 += f * dxs[k] * dxs[k]
         m12 += f * dxs[k] * dys[k]
         m22 += f * dys[k] * dys[k]
+    return m00, m01, m02, m11, m12, m22
+
+
+@numba.njit(inline="always")
+def linear_row(n, idx, dxs, dys, phis, dphis, inv, mode, base, indices, out):
+    """One point's linear-basis RK entries from its gathered neighbours, written at ``base``.
+
+    The 3 x 3 moment matrix is inverted by cofactors. Returns det(A) / prod(diag(A)) (0 when A
+    is singular, and nothing is written then).
+    """
+    m00, m01, m02, m11, m12, m22 = moments(n, dxs, dys, phis)
     c00 = m11 * m22 - m12 * m12
     c01 = m02 * m12 - m01 * m22
     c02 = m01 * m12 - m02 * m11

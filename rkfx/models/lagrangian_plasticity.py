@@ -36,10 +36,11 @@ the force: an artificial viscosity that vanishes with the particle spacing.
 The lumped mass of coefficient I is the particle mass m_I (a constant; the row sums of the
 moving approximation would change from step to step), and gravity is m_I g.
 
-Status (measured on the collapse of a dry column, docs/large_deformation.md): SNNI runs the
-collapse to rest; NSNI with (6.76) and the VC-corrected rules run it to t ~ 0.1-0.2 s and then
-a particle at the sheared front is turned inside out; a viscosity beta = 0.1 carries NSNI to
-rest at 21 particles across the column but not at 41.
+Status (measured on the collapse of a dry column, docs/large_deformation.md): with the sheet
+rows of ``rkfx.approximation.semi_lagrangian`` SNNI and NSNI without the VC correction run the
+collapse to the end at 21-81 particles across, far too mobile without viscosity and nearly to
+rest near the published run-out with beta = 0.1 (not a converged result: eta falls with h);
+the VC-corrected rules still fail (non-symmetric systems).
 """
 from collections.abc import Mapping, Sequence
 
@@ -128,7 +129,7 @@ class LagrangianPlasticity(ExplicitBase):
         self.plastic_strain = np.zeros(n)
         self.d_last = np.zeros(2 * n)
         self.counters = np.zeros(3, np.int64)  # steps, steps with a search, rows searched
-        self.torn = np.zeros(1, np.int64)  # evaluation points given Shepard rows (torn-off particles)
+        self.torn = np.zeros(2, np.int64)  # evaluation points given Shepard rows and sheet rows
         self.yielded = np.zeros(n, bool)
         self.contact: WallContact | None = None
         self._rebuild(fresh=True)
@@ -212,6 +213,8 @@ class LagrangianPlasticity(ExplicitBase):
     def restore(self, arrays: Mapping[str, np.ndarray]) -> None:
         for key in self.state():
             setattr(self, key, np.array(arrays[key]))
+        if self.torn.shape == (1,):  # a checkpoint written before sheet rows were counted
+            self.torn = np.array([self.torn[0], 0], np.int64)
         self._rebuild(fresh=True)
 
     @property
@@ -219,4 +222,4 @@ class LagrangianPlasticity(ExplicitBase):
         """Steps run, steps that searched some rows again, and rows searched in all."""
         steps, searches, rows = map(int, self.counters)
         return {"steps": steps, "steps_with_search": searches, "rows_searched": rows,
-                "torn_point_evaluations": int(self.torn[0])}
+                "torn_point_evaluations": int(self.torn[0]), "sheet_point_evaluations": int(self.torn[1])}
