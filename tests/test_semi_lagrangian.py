@@ -141,6 +141,9 @@ def test_a_sheet_along_any_direction_gets_rows_along_it(angle):
             assert np.abs(rows @ (x @ n)[:, None])[:, 1:3].max() < 1e-3  # not 1e4 / h
         if "second" in kw:
             assert np.array_equal(rows.data[:, 3:], np.zeros_like(rows.data[:, 3:]))
+        if "implicit" in kw:  # entries of order 1 / h, where the full rows carry 8e4 (h = 0.1)
+            full = evaluate_moving(moving_rk(x, 0.25, 0.02), **kw)
+            assert np.abs(rows.data[:, 1:]).max() < 20.0 < 1e4 < np.abs(full.data[:, 1:]).max()
     assert counter.tolist() == [0, 44]
     p = structured(1.0, 1.0, 11, 11)
     counted = evaluate_moving(moving_rk(p.x, 0.2, 0.02, torn=counter), second=True)
