@@ -9,7 +9,7 @@ central differences at ``cfl`` h / c;
 with the run-out, the height at the wall, how long the run went and why it stopped.
 
     python bench/column_collapse.py [--nx 21] [--rule nsni] [--t-end 0.7] [--viscosity 0]
-        [--cfl 0.3] [--support 2] [--floor-friction 0.36]
+        [--cfl 0.3] [--support 2] [--floor-friction 0.36] [--width 0.2] [--height 0.1]
 """
 import argparse
 import time
@@ -51,8 +51,10 @@ def main() -> None:
     ap.add_argument("--cfl", type=float, default=0.3)
     ap.add_argument("--support", type=float, default=2.0, help="support radius a_I in particle spacings")
     ap.add_argument("--floor-friction", type=float, default=float(np.tan(np.radians(19.8))))
+    ap.add_argument("--width", type=float, default=0.2, help="column width L [m] (nx particles across it)")
+    ap.add_argument("--height", type=float, default=0.1, help="column height H [m] (aspect ratio a = H / L)")
     args = ap.parse_args()
-    width, height = 0.2, 0.1
+    width, height = args.width, args.height
     h = width / (args.nx - 1)
     p = structured(width, height, args.nx, int(round(height / h)) + 1)
     soil = DruckerPrager(E=0.84e6, nu=0.3, phi=19.8, c=0.0, psi=0.0)
