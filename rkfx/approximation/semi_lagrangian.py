@@ -21,7 +21,7 @@ import numpy as np
 
 from rkfx.approximation.kernel import cubic_spline
 from rkfx.approximation.neighbours import CHUNK, support_neighbours
-from rkfx.approximation.shape_functions import DIRECT, IMPLICIT, RCOND_MIN, SECOND, VALUES, linear_row, moments
+from rkfx.approximation.shape_functions import DIRECT, IMPLICIT, RCOND_MIN, SECOND, VALUES, moments, row_from_moments
 from rkfx.approximation.sparse_rows import SparseRows
 from rkfx.errors import InputError, SingularMomentMatrix, point_str
 
@@ -205,10 +205,11 @@ SHEET_SPREAD = 5e-3
 
 
 @numba.njit(inline="always")
-def _spread(n, dxs, dys, phis):
+def _spread(sums):
     """The smallest kernel-weighted variance of the (scaled) offsets and the unit direction
-    (tx, ty) of the largest: a sheet's spread across it and its direction along it."""
-    m0, mx, my, mxx, mxy, myy = moments(n, dxs, dys, phis)
+    (tx, ty) of the largest, from the moment sums of ``moments``: a sheet's spread across it and
+    its direction along it."""
+    m0, mx, my, mxx, mxy, myy = sums
     if not m0 > 0.0:
         return 0.0, 1.0, 0.0
     cxx = mxx / m0 - (mx / m0) ** 2
@@ -287,17 +288,20 @@ def _rows_listed(x, a, points, owner, scale, cand_ptr, cand_idx, indptr, kmax, m
             o = owner[p]
             n = _gather_listed(points[p, 0], points[p, 1], x, a, cand_idx, cand_ptr[o], cand_ptr[o + 1],
                                idx, dxs, dys, phis, dphis, inv)
-            ratio[p] = linear_row(n, idx, dxs, dys, phis, dphis, inv, mode, indptr[p], indices, out)
+            sums = moments(n, dxs, dys, phis)
             if shepard > 0.0 and n > 0:
-                across, tx, ty = _spread(n, dxs, dys, phis)
+                across, tx, ty = _spread(sums)
                 if across < SHEET_SPREAD:
                     if _sheet_row(n, idx, dxs, dys, phis, tx, ty, inv, indptr[p], indices, out):
                         ratio[p] = -2.0
                     else:
-                        ratio[p] = 0.0
-                if not (ratio[p] >= shepard or ratio[p] == -2.0):
-                    _shepard_row(n, idx, phis, indptr[p], indices, out)
-                    ratio[p] = -1.0
+                        _shepard_row(n, idx, phis, indptr[p], indices, out)
+                        ratio[p] = -1.0
+                    continue
+            ratio[p] = row_from_moments(sums, n, idx, dxs, dys, phis, dphis, inv, mode, indptr[p], indices, out)
+            if shepard > 0.0 and n > 0 and not ratio[p] >= shepard:
+                _shepard_row(n, idx, phis, indptr[p], indices, out)
+                ratio[p] = -1.0
 
 
 def evaluate_moving(rk: MovingRK, points: np.ndarray | None = None, owner: np.ndarray | None = None,

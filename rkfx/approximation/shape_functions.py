@@ -208,7 +208,13 @@ def linear_row(n, idx, dxs, dys, phis, dphis, inv, mode, base, indices, out):
     The 3 x 3 moment matrix is inverted by cofactors. Returns det(A) / prod(diag(A)) (0 when A
     is singular, and nothing is written then).
     """
-    m00, m01, m02, m11, m12, m22 = moments(n, dxs, dys, phis)
+    return row_from_moments(moments(n, dxs, dys, phis), n, idx, dxs, dys, phis, dphis, inv, mode, base, indices, out)
+
+
+@numba.njit(inline="always")
+def row_from_moments(sums, n, idx, dxs, dys, phis, dphis, inv, mode, base, indices, out):
+    """``linear_row`` with the moment sums of ``moments`` already formed."""
+    m00, m01, m02, m11, m12, m22 = sums
     c00 = m11 * m22 - m12 * m12
     c01 = m02 * m12 - m01 * m22
     c02 = m01 * m12 - m02 * m11
