@@ -142,15 +142,26 @@ def test_bad_input_is_named():
         Wall((0, 0), (0, 1), -0.1)
 
 
-def test_viscosity_damps_the_ringing():
-    """The artificial viscosity takes energy out of an elastic block bouncing on the floor."""
+@pytest.mark.parametrize("viscous", [{"viscosity": 0.2}, {"eta": 100.0}])
+def test_viscosity_damps_the_ringing(viscous):
+    """The artificial viscosity (beta rho c h, here 104 Pa s inside) and a fixed one each take
+    energy out of an elastic block bouncing on the floor."""
     soil = DruckerPrager(E=SAND.E, nu=SAND.nu, phi=SAND.phi, c=2e3)
     walls = [Wall((0, 0), (0, 1), 0.5, "floor")]
     ke = []
-    for beta in (0.0, 0.2):
-        _, model, dt = _block(soil=soil, walls=walls, viscosity=beta)
+    for kw in ({}, viscous):
+        _, model, dt = _block(soil=soil, walls=walls, **kw)
         run = CentralDifference(dt).run(model, 400)
         ke.append(run.state.energies()["kinetic"])
-    assert ke[1] < 0.5 * ke[0]
+    assert ke[1] < 0.5 * ke[0], ke
+
+
+def test_viscosity_bad_input():
     with pytest.raises(InputError, match="viscosity"):
         _block(viscosity=-1.0)
+    with pytest.raises(InputError, match="eta"):
+        _block(eta=np.nan)
+    # a fixed viscosity beyond the explicit step's limit at the corner particles (V = h^2 / 4)
+    _block(eta=400.0)
+    with pytest.raises(InputError, match="explicit limit of the viscosity"):
+        _block(eta=600.0)

@@ -31,7 +31,9 @@ internal force is called once per step with the new d and commits the step):
 
 With ``viscosity`` beta > 0 a viscous stress 2 eta D (eta = beta rho c h_L, c the elastic
 wave speed, h_L = sqrt(V_L), D the rate of deformation of the last step) is added to sigma in
-the force: an artificial viscosity that vanishes with the particle spacing.
+the force: an artificial viscosity that vanishes with the particle spacing. ``eta`` [Pa s]
+adds a fixed viscosity to it, the same at every spacing: a Kelvin-Voigt regularization of the
+material itself, under which a sequence of refinements has a limit to converge to.
 
 The lumped mass of coefficient I is the particle mass m_I (a constant; the row sums of the
 moving approximation would change from step to step), and gravity is m_I g.
@@ -87,12 +89,15 @@ class LagrangianPlasticity(ExplicitBase):
         skin: Verlet skin of the neighbour search [m] (default half the smallest support / 2).
         kappa: Wall penalty in units of m / dt^2.
         max_dilation: Bound on V_L / V_L^0 and V_L^0 / V_L (see the module docstring).
+        viscosity: beta of the artificial viscosity eta = beta rho c h_L (module docstring).
+        eta: A fixed viscosity [Pa s] added to it.
     """
 
     def __init__(self, x: np.ndarray, volume: np.ndarray, support, boundary: np.ndarray, soil: DruckerPrager,
                  density: float, dt: float, *, rule: str = "nsni", walls: Sequence[Wall] = (),
                  gravity=(0.0, -9.81), stress: np.ndarray | None = None, skin: float | None = None,
-                 kappa: float = 0.1, max_dilation: float = 1.25, viscosity: float = 0.0):
+                 kappa: float = 0.1, max_dilation: float = 1.25, viscosity: float = 0.0,
+                 eta: float = 0.0):
         x = np.array(x, dtype=np.float64)
         n = len(x)
         if rule not in RULES:
@@ -116,8 +121,21 @@ class LagrangianPlasticity(ExplicitBase):
         self.volume0, self.max_dilation = self.volume.copy(), float(max_dilation)
         if not (np.isfinite(viscosity) and viscosity >= 0.0):
             raise InputError(f"viscosity = {viscosity!r} must be >= 0 (a fraction of rho c h)")
-        self.viscosity, self.rate = float(viscosity), None
-        self._eta = density * np.sqrt((soil.bulk_modulus + 4.0 * soil.shear_modulus / 3.0) / density)
+        if not (np.isfinite(eta) and eta >= 0.0):
+            raise InputError(f"eta = {eta!r} must be a viscosity >= 0 [Pa s]")
+        self.viscosity, self.eta, self.rate = float(viscosity), float(eta), None
+        self._rho_c = density * np.sqrt((soil.bulk_modulus + 4.0 * soil.shear_modulus / 3.0) / density)
+        if self.viscosity > 0.0 or self.eta > 0.0:
+            # The explicit viscous stress needs dt <= 2 rho V_L / eta_L at the smallest particle
+            # (V_L down to V_L^0 / max_dilation; measured on the column collapse of
+            # bench/column_collapse.py, corner V^0 = h^2 / 6: a fixed eta ran to the end at 0.28
+            # and 0.56 of it, at 21 and 41 across, and turned the corner inside out within 39
+            # steps at 1.1).
+            small = self.volume0 / self.max_dilation
+            limit = float(np.min(2.0 * density * small / (self.eta + self.viscosity * self._rho_c * np.sqrt(small))))
+            if dt > limit:
+                raise InputError(f"dt = {dt:.3g} s is beyond the explicit limit of the viscosity, 2 rho V / eta = "
+                                 f"{limit:.3g} s at the smallest particle; reduce dt, eta or viscosity")
         self.particle_mass = self.density * self.volume
         self.layout = single("u", 2, 2, n)
         self.essential = ()
@@ -171,8 +189,11 @@ class LagrangianPlasticity(ExplicitBase):
             self.d_last = d.copy()
         r = self.rule
         total = self.stress
-        if self.viscosity > 0.0 and self.rate is not None:
-            total = self.stress + self.rate * (self.viscosity * np.sqrt(self.volume))[:, None]
+        if self.rate is not None:
+            if self.viscosity > 0.0:
+                total = total + (self._rho_c * self.rate) * (self.viscosity * np.sqrt(self.volume))[:, None]
+            if self.eta > 0.0:
+                total = total + self.eta * self.rate
         f = _divergence(r.test, r.weights[:, None] * total)
         if r.moments is not None:
             tau = self.implicit @ self.stress  # (n, 3, 4): [sigma, d sigma / dx, d sigma / dy] at the particles
@@ -188,9 +209,9 @@ class LagrangianPlasticity(ExplicitBase):
     def _advance(self, du: np.ndarray) -> None:
         r = self.rule
         L = _gradients(r.trial, du)
-        if self.viscosity > 0.0:
+        if self.viscosity > 0.0 or self.eta > 0.0:
             d = jaumann.strain_increment(L, 1.0 / self.dt)
-            self.rate = np.column_stack([2.0 * d[:, 0], 2.0 * d[:, 1], np.zeros(len(d)), d[:, 2]]) * self._eta
+            self.rate = np.column_stack([2.0 * d[:, 0], 2.0 * d[:, 1], np.zeros(len(d)), d[:, 2]])
         rotated = jaumann.rotated(self.stress, L, 1.0)
         step = self.soil.update(rotated, jaumann.strain_increment(L, 1.0), self.plastic_strain)
         self.stress, self.plastic_strain, self.yielded = step.stress, step.plastic_strain, step.yielded
