@@ -4,11 +4,12 @@ The set-up of Bui et al. (2008): a column 0.2 m long and 0.1 m high against a sm
 x = 0, released at t = 0 onto a floor with Coulomb friction; E = 0.84 MPa, nu = 0.3,
 rho = 2650 kg/m^3, phi = 19.8 deg, c = 0, psi = 0; geostatic start with K0 = 1 - sin(phi).
 ``rkfx.models.lagrangian_plasticity`` on a grid of ``nx`` particles across, a = 2 h,
-central differences at ``cfl`` h / c;
+central differences at ``cfl`` h / c (the column of ``rkfx.cases.granular_collapse``, which
+runs it against the published run-outs);
 ``--support`` sets a in spacings (2 by default). Prints the state every tenth of the run and a last line
 with the run-out, the height at the wall, how long the run went and why it stopped.
 
-    python bench/column_collapse.py [--nx 21] [--rule nsni] [--t-end 0.7] [--viscosity 0]
+    python bench/column_collapse.py [--nx 21] [--rule nsni] [--t-end 0.7] [--viscosity 0] [--eta 0]
         [--cfl 0.3] [--support 2] [--floor-friction 0.36] [--width 0.2] [--height 0.1]
 """
 import argparse
@@ -16,12 +17,9 @@ import time
 
 import numpy as np
 
-from rkfx.assembly.rigid_walls import Wall
+from rkfx.cases.granular_collapse import column
 from rkfx.errors import InputError
-from rkfx.geometry.nodal_domains import nodal_domains
-from rkfx.geometry.particles import structured
 from rkfx.materials.drucker_prager import DruckerPrager
-from rkfx.models.lagrangian_plasticity import LagrangianPlasticity
 from rkfx.solvers.central_difference import CentralDifference
 
 
@@ -47,7 +45,8 @@ def main() -> None:
     ap.add_argument("--nx", type=int, default=21)
     ap.add_argument("--rule", default="nsni")
     ap.add_argument("--t-end", type=float, default=0.7)
-    ap.add_argument("--viscosity", type=float, default=0.0)
+    ap.add_argument("--viscosity", type=float, default=0.0, help="beta of the artificial viscosity beta rho c h")
+    ap.add_argument("--eta", type=float, default=0.0, help="a fixed viscosity [Pa s], the same at every spacing")
     ap.add_argument("--cfl", type=float, default=0.3)
     ap.add_argument("--support", type=float, default=2.0, help="support radius a_I in particle spacings")
     ap.add_argument("--floor-friction", type=float, default=float(np.tan(np.radians(19.8))))
@@ -56,20 +55,13 @@ def main() -> None:
     args = ap.parse_args()
     width, height = args.width, args.height
     h = width / (args.nx - 1)
-    p = structured(width, height, args.nx, int(round(height / h)) + 1)
     soil = DruckerPrager(E=0.84e6, nu=0.3, phi=19.8, c=0.0, psi=0.0)
-    rho, g = 2650.0, 9.81
-    k0 = 1.0 - np.sin(np.radians(soil.phi))
-    sy = -rho * g * (height - p.x[:, 1])
-    stress = np.column_stack([k0 * sy, sy, k0 * sy, 0.0 * sy])
-    c = np.sqrt((soil.bulk_modulus + 4.0 * soil.shear_modulus / 3.0) / rho)
-    dt = args.cfl * h / c
-    walls = [Wall((0, 0), (0, 1), args.floor_friction, "floor"), Wall((0, 0), (1, 0), 0.0, "wall")]
-    model = LagrangianPlasticity(p.x, nodal_domains(p).area, args.support * h, p.boundary_edges, soil, rho, dt, rule=args.rule,
-                                 walls=walls, stress=stress, gravity=(0.0, -g), viscosity=args.viscosity)
+    model, dt, p = column(width, height, args.nx, int(round(height / h)) + 1, soil, 2650.0, 9.81, rule=args.rule,
+                          floor_friction=args.floor_friction, cfl=args.cfl, support=args.support,
+                          viscosity=args.viscosity, eta=args.eta)
     steps = int(np.ceil(args.t_end / dt))
     print(f"{len(p.x)} particles, h = {h:.4g} m, dt = {dt:.3g} s, {steps} steps, rule {args.rule}, "
-          f"a = {args.support} h, viscosity {args.viscosity}", flush=True)
+          f"a = {args.support} h, viscosity {args.viscosity}, eta {args.eta} Pa s", flush=True)
     t0 = time.perf_counter()
     why = "ran to t_end"
     try:

@@ -29,6 +29,9 @@ the machine cannot hold it), see ``rkfx.cases._preflight``.
                       NSNI with the retention law against Taylor-Hood on the same grid.
     levee             a levee's initial state (seed 6.4.3, stage 1): steady seepage under gravity
                       through a seepage face, RKPM on gmsh nodes beside Taylor-Hood.
+    granular_collapse dry granular columns collapsing on moving particles (chapter 6's large
+                      deformation): run-outs against Lube et al. (2005), NSNI with and without
+                      the VC correction.
     cryer             Cryer's poroelastic sphere (3-D, seed 3.3.2): RKPM SCNI + FPP on gmsh
                       tetrahedra against the exact solution, NI's early oscillation, Taylor-Hood.
 """

@@ -50,7 +50,7 @@ import numpy as np
 
 from rkfx.approximation.semi_lagrangian import evaluate_moving, moved, moving_rk
 from rkfx.assembly.rigid_walls import Wall, WallContact, wall_forces
-from rkfx.errors import InputError
+from rkfx.errors import InputError, point_str
 from rkfx.integration.nodal_stabilized import RULES, boundary_rule, nodal_cells, nodal_integration
 from rkfx.materials import jaumann
 from rkfx.materials.drucker_prager import DruckerPrager
@@ -218,7 +218,7 @@ class LagrangianPlasticity(ExplicitBase):
         jac = (1.0 + L[:, 0, 0]) * (1.0 + L[:, 1, 1]) - L[:, 0, 1] * L[:, 1, 0]
         if not np.all(jac > 0):
             bad = int(np.flatnonzero(~(jac > 0))[0])
-            raise InputError(f"particle {bad} at {tuple(np.round(self.x[bad], 6))} was turned inside out in one step "
+            raise InputError(f"particle {bad} at {point_str(self.x[bad])} was turned inside out in one step "
                              f"(det F = {jac[bad]:.3g}); reduce the time step")
         self.volume = np.clip(self.volume * jac, self.volume0 / self.max_dilation, self.volume0 * self.max_dilation)
         self.x = self.x + (r.values @ du)[:, 0]
