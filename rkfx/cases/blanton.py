@@ -181,7 +181,7 @@ PARAMS = {
     "jacobian": Param("symmetric", "Newton's Jacobian: symmetric (5.36) or full (with dK_H/dU)"),
     "damage_update": Param("impl-ex", "impl-ex (extrapolated over a step) or implicit (every Newton iterate)"),
     "support_factor": Param(1.5, "RK support radius / spacing [-]"),
-    "max_cuts": Param(8, "halvings of a step whose Newton fails before the run stops [-]"),
+    "max_cuts": Param(12, "halvings of a step whose Newton fails before the run stops [-]"),
     "closure": Param(False, "a closed crack carries compression across it (rkfx.fracture.closure); "
                             "false: the seed's isotropic damage"),
 }
@@ -538,7 +538,7 @@ def run(*, methods: Sequence[str] = ("rkpm",), E=1e10, nu=0.22, rho_s=1900.0, rh
         gamma_w=1e4, K_w=2.2e9, K_s=1e11, GF=35.0, ft=5e6, viscosity=1e-3, side=0.305, offset=0.05, notch=0.04,
         tests=tuple(TESTS), h=(5e-3, 3.5e-3), mu=0.7, penalty=1.0, t_confine=100.0, t_drain=100.0, t_ramp=0.01,
         dt=5e-4, t_grow=0.2, margin=0.015, tol=0.3, radius=3.5, jacobian="symmetric", damage_update="impl-ex",
-        support_factor=1.5, max_cuts=8, closure=False, checkpoint_every=0, work_dir=None, resume=None, vtk=None) -> Results:
+        support_factor=1.5, max_cuts=12, closure=False, checkpoint_every=0, work_dir=None, resume=None, vtk=None) -> Results:
     """Every test at every spacing; see the module docstring. ``vtk``: a folder for the ParaView
     files (``--vtk``)."""
     material = dict(E=E, nu=nu, rho_s=rho_s, rho_w=rho_w, porosity=porosity, k_h=k_h, gamma_w=gamma_w, K_w=K_w,
