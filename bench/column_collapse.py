@@ -17,19 +17,19 @@ import time
 
 import numpy as np
 
-from rkfx.cases.granular_collapse import column
+from rkfx.cases.granular_collapse import column, detached, front, wall_height
 from rkfx.errors import InputError
 from rkfx.materials.drucker_prager import DruckerPrager
 from rkfx.solvers.central_difference import CentralDifference
 
 
 class _Printer:
-    def __init__(self, model, t0):
-        self.model, self.t0 = model, t0
+    def __init__(self, model, t0, width, h):
+        self.model, self.t0, self.width, self.h = model, t0, width, h
 
     def record(self, s):
-        m = self.model
-        print(f"t={s.time:.3f} s  front={m.x[:, 0].max():.4f} m  height at wall={m.x[m.x[:, 0] < 0.01, 1].max():.4f} m  "
+        m, w = self.model, self.width
+        print(f"t={s.time:.3f} s  front={w * (1 + front(m, w)):.4f} m  height at wall={wall_height(m, self.h):.4f} m  "
               f"kinetic={s.energies()['kinetic']:.3e} J  max eps_p={m.plastic_strain.max():.2f}  "
               f"wall time={time.perf_counter() - self.t0:.1f} s", flush=True)
 
@@ -56,7 +56,7 @@ def main() -> None:
     width, height = args.width, args.height
     h = width / (args.nx - 1)
     soil = DruckerPrager(E=0.84e6, nu=0.3, phi=19.8, c=0.0, psi=0.0)
-    model, dt, p = column(width, height, args.nx, int(round(height / h)) + 1, soil, 2650.0, 9.81, rule=args.rule,
+    model, dt, p = column(width, height, args.nx, None, soil, 2650.0, 9.81, rule=args.rule,
                           floor_friction=args.floor_friction, cfl=args.cfl, support=args.support,
                           viscosity=args.viscosity, eta=args.eta)
     steps = int(np.ceil(args.t_end / dt))
@@ -65,13 +65,14 @@ def main() -> None:
     t0 = time.perf_counter()
     why = "ran to t_end"
     try:
-        CentralDifference(dt).run(model, steps, output_every=max(1, steps // 10), recorder=_Printer(model, t0))
+        CentralDifference(dt).run(model, steps, output_every=max(1, steps // 10), recorder=_Printer(model, t0, width, h))
     except InputError as e:
         why = f"stopped: {e}"
     wall = time.perf_counter() - t0
     done = model.neighbour_rebuilds["steps"]
-    print(f"run-out {model.x[:, 0].max():.4f} m (dL/L = {(model.x[:, 0].max() - width) / width:.3f}), "
-          f"height at the wall {model.x[model.x[:, 0] < 0.01, 1].max():.4f} m, t = {done * dt:.3f} s after {done} "
+    runout = front(model, width)
+    print(f"run-out {width * (1 + runout):.4f} m (dL/L = {runout:.3f}; {detached(model)} particles thrown ahead), "
+          f"height at the wall {wall_height(model, h):.4f} m, t = {done * dt:.3f} s after {done} "
           f"steps, {1e3 * wall / max(done, 1):.1f} ms/step; {model.neighbour_rebuilds}; {why}")
 
 

@@ -24,6 +24,17 @@ def test_the_published_runouts():
     assert bui_final_height(0.5) == 1.0 and bui_final_height(3.0) < 0.5
 
 
+def test_the_front_is_the_deposit_not_a_particle_thrown_ahead():
+    """The run-out ends at the first gap along x wider than a support; a particle thrown beyond
+    it is counted apart, and a body without gaps reaches its farthest particle."""
+    from types import SimpleNamespace
+    x = np.c_[np.linspace(0.0, 0.3, 31), np.zeros(31)]  # spacing 0.01 m
+    body = SimpleNamespace(x=x, support=np.full(31, 0.02))
+    assert gc.front(body, 0.2) == pytest.approx(0.5) and gc.detached(body) == 0
+    thrown = SimpleNamespace(x=np.vstack([x, [[0.45, 0.05]]]), support=np.full(32, 0.02))
+    assert gc.front(thrown, 0.2) == pytest.approx(0.5) and gc.detached(thrown) == 1
+
+
 def test_columns_collapse_without_creating_energy(small):
     """Without the VC correction both columns run to the end; the low one keeps its height at the
     wall (Bui et al. 2015: below a = 0.65) while its toe moves out, the tall one falls to under

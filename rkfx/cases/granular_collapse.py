@@ -131,14 +131,16 @@ def memory_need(methods, *, height, aspects, across, **_) -> _preflight.Need:
     return _preflight.need(BYTES_PER_PARTICLE, count, f"across={across}", "lower across")
 
 
-def column(width: float, height: float, nx: int, ny: int, soil: DruckerPrager, rho: float, gravity: float, *,
+def column(width: float, height: float, nx: int, ny: int | None, soil: DruckerPrager, rho: float, gravity: float, *,
            rule: str, floor_friction: float, cfl: float = 0.3, support: float = 2.0, viscosity: float = 0.0,
            eta: float = 0.0):
     """A column of nx x ny particles at rest in its geostatic state against the wall at x = 0 on the
     floor y = 0, as the model of a collapse; returns (model, dt, particles). The support is
-    ``support`` spacings, the step ``cfl`` h / c (c the elastic P-wave speed)."""
+    ``support`` spacings, the step ``cfl`` h / c (c the elastic P-wave speed); ``ny=None``: the
+    rows whose spacing is nearest to the spacing h along x."""
+    h = width / (nx - 1)
+    ny = int(round(height / h)) + 1 if ny is None else ny
     p = structured(width, height, nx, ny)
-    h = width / (nx - 1)  # the spacing along y is the nearest to it that fills the height
     k0 = 1.0 - np.sin(np.radians(soil.phi))
     sy = -rho * gravity * (height - p.x[:, 1])
     stress = np.column_stack([k0 * sy, sy, k0 * sy, 0.0 * sy])
@@ -151,8 +153,21 @@ def column(width: float, height: float, nx: int, ny: int, soil: DruckerPrager, r
 
 
 def front(model, width: float) -> float:
-    """The run-out (L_inf - L) / L of the particles' farthest reach."""
-    return float((model.x[:, 0].max() - width) / width)
+    """The run-out (L_inf - L) / L of the deposit: its farthest particle that the others join
+    to the wall without a gap along x wider than a support (a particle thrown ahead of the body
+    does not count; ``detached`` counts those beyond)."""
+    return float((_reach(model) - width) / width)
+
+
+def detached(model) -> int:
+    """Particles beyond the deposit's front (thrown ahead of it, ``front``)."""
+    return int(np.sum(model.x[:, 0] > _reach(model)))
+
+
+def _reach(model) -> float:
+    x = np.sort(model.x[:, 0])
+    gap = np.flatnonzero(np.diff(x) > float(np.min(model.support)))
+    return float(x[gap[0]] if gap.size else x[-1])
 
 
 def wall_height(model, h: float) -> float:
@@ -215,6 +230,7 @@ def _collapse(aspect, rule, prm, ck) -> Run:
             "bui_final_height": float(bui_final_height(aspect)),
             "kinetic_end": float(ke[-1]) if completed else float("nan"), "kinetic_peak": float(ke.max(initial=0.0)),
             "gravity_work": gravity_work, "energy_created": int(bool(ke.max(initial=0.0) > gravity_work)),
+            "detached": detached(model),
             "creep_last_tenth": float((fr[last].max() - fr[last].min()) * width) if completed else float("nan"),
             "ms_per_step": 1e3 * wall / max(done, 1), **model.neighbour_rebuilds}
     errors = {"runout_vs_lube": abs(runout - lube) / lube if completed else float("inf")}
