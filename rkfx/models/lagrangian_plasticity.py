@@ -132,8 +132,10 @@ class LagrangianPlasticity(ExplicitBase):
             # bench/column_collapse.py, corner V^0 = h^2 / 6: a fixed eta ran to the end at 0.28
             # and 0.56 of it, at 21 and 41 across, and turned the corner inside out within 39
             # steps at 1.1). It is necessary, not sufficient: at 81 across a run at 0.45 of it
-            # failed near the free top and ran at half the step (elasticity and viscosity
-            # together limit it more tightly).
+            # failed near the free top and ran at half the step, though the linear limit of
+            # elasticity and viscosity together, omega dt <= 2 (sqrt(1 + xi^2) - xi) with the
+            # initial omega_max dt = 0.59 at cfl 0.3 and xi = nu / 2 omega, allowed 0.99: a
+            # local failure of the flow, not the step's linear limit.
             small = self.volume0 / self.max_dilation
             limit = float(np.min(2.0 * density * small / (self.eta + self.viscosity * self._rho_c * np.sqrt(small))))
             if dt > limit:
