@@ -8,7 +8,7 @@ base fixed in y and impermeable, the top drained (p = 0) and loaded by a compres
 q from t = 0.
 
 On a communicator of several ranks the nodes are split by RCB: each rank's rule covers its own
-nodes' cells only, and ``rkfx.cases._nodal_up.rank_unknowns`` gives its local unknowns (own
+nodes' cells only, and ``rkfx.cases._nodal_up.split_over_ranks`` gives its local unknowns (own
 nodes, then ghosts).
 """
 from collections.abc import Callable
@@ -18,7 +18,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from rkfx.approximation.semi_lagrangian import MovingRK
-from rkfx.cases._nodal_up import edge_load, nodal_discretization, rank_unknowns
+from rkfx.cases._nodal_up import edge_load, nodal_discretization, split_over_ranks
 from rkfx.errors import InputError
 from rkfx.geometry.particles import Particles, structured
 from rkfx.integration.nodal_stabilized import NodalIntegration
@@ -108,10 +108,7 @@ def confined_column(ny: int, rule: str = "nsni", medium: Constituents = SOARES, 
     axis = np.abs(x[:, 0] - h) < tol
     probe = sp.vstack([collocation_rows(rk, np.flatnonzero(axis & (x[:, 1] > height - tol)), 1, n, 0, size),
                        collocation_rows(rk, np.flatnonzero(axis & (x[:, 1] < tol)), None, n, 2 * n, size)]).tocsr()
-    local = None
-    if d.own is not None:
-        local = rank_unknowns(d, sp.vstack(rows), comm)
-        rows = [g[:, local.index].tocsr() for g in rows]
+    local, rows, sample = split_over_ranks(d, comm, rows, probe)
     essential = [Constraint(g) for g in rows]
     return ConfinedColumn(ExplicitPoroDynamics(r, medium, essential, load=lambda t: f, local=local, fpp=fpp), int(top[0]),
-                          int(bottom[0]), probe.__matmul__ if local is None else local.observer(probe))
+                          int(bottom[0]), sample)

@@ -6,7 +6,8 @@ of half a spacing), their median-dual areas as square cells, and any rule of
 ``rkfx.integration.nodal_stabilized.RULES``. On a communicator of several ranks the nodes are
 split by RCB: each rank's rule covers its own nodes' cells only, and ``rank_unknowns`` gives
 its local u-p unknowns (own nodes, then the ghosts its rows touch), ``owned`` the rank's share
-of a node set and ``whole_unknowns`` a model's size over all ranks. ``edge_load``: the force of
+of a node set, ``split_over_ranks`` a model's conditions and probes over the local unknowns and
+``whole_unknowns`` a model's size over all ranks. ``edge_load``: the force of
 a traction on boundary edges.
 """
 from typing import NamedTuple
@@ -67,6 +68,19 @@ def rank_unknowns(d, constraints: sp.spmatrix, comm) -> LocalUnknowns:
     cols = sp.csr_matrix(constraints).indices
     touched = np.unique(np.r_[d.own, np.where(cols < 2 * n, cols // 2, cols - 2 * n), d.rule.columns()])
     return local_unknowns(d.numbering, touched, (2, 1), comm)
+
+
+def split_over_ranks(d, comm, constraints: list[sp.spmatrix], probe: sp.spmatrix,
+                     touching: sp.spmatrix | None = None):
+    """A model's pieces over a rank's local unknowns: ``(local, constraints, sample)``, with
+    ``local`` of ``rank_unknowns`` for the ghosts that ``touching`` (default: the
+    ``constraints``) touches, the ``constraints`` rows over the local unknowns, and ``sample``
+    the ``probe`` rows (over the whole vector) as a function of the local one (collective).
+    Serially: ``(None, constraints, probe @)``."""
+    if d.own is None:
+        return None, constraints, probe.__matmul__
+    local = rank_unknowns(d, sp.vstack(constraints) if touching is None else touching, comm)
+    return local, [sp.csr_matrix(c)[:, local.index].tocsr() for c in constraints], local.observer(probe)
 
 
 def edge_load(rk: MovingRK, edges: np.ndarray, traction) -> np.ndarray:

@@ -71,7 +71,7 @@ from rkfx.assembly.seepage_face import seepage_face
 from rkfx.assembly.weighted_forms import placed
 from rkfx.cases import _cli, _preflight
 from rkfx.cases._cli import Param, Results, Run
-from rkfx.cases._nodal_up import edge_load, nodal_discretization, owned, rank_unknowns, whole_unknowns
+from rkfx.cases._nodal_up import edge_load, nodal_discretization, owned, split_over_ranks, whole_unknowns
 from rkfx.errors import InputError
 from rkfx.integration.nodal_stabilized import RULES
 from rkfx.materials.drucker_prager import DruckerPrager, invariants
@@ -220,13 +220,8 @@ def rkpm_levee(p, soil: UnsaturatedSoil, levee: Levee, h: float, rule: str, poin
     nearest = cKDTree(x).query(points)[1]
     rows = evaluate_moving(d.rk, points, nearest).matrix().tocsr()
     rows = sp.vstack([placed(rows, size, 2 * n), placed(rows, size, 0, 2), placed(rows, size, 1, 2)]).tocsr()
-    local = None
-    if d.own is not None:
-        local = rank_unknowns(d, sp.vstack([G, placed(face.matrix(), size, 2 * n), rows]), comm)
-        G = G[:, local.index].tocsr()
-        sample = local.observer(rows)
-    else:
-        sample = rows.__matmul__
+    local, (G,), sample = split_over_ranks(d, comm, [G], rows,
+                                           touching=sp.vstack([G, placed(face.matrix(), size, 2 * n), rows]))
     model = UnsaturatedBiotModel(d.rule, soil, Constraints(G, g), local, seepage=face, weight="full", load=load)
     return model, sample, d
 

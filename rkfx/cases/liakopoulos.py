@@ -75,7 +75,7 @@ from rkfx.assembly.weighted_forms import placed
 from rkfx.cases import _cli, _preflight
 from rkfx.cases._cli import Param, Results, Run
 from rkfx.cases._confined_column import column_discretization
-from rkfx.cases._nodal_up import owned, rank_unknowns, whole_unknowns
+from rkfx.cases._nodal_up import owned, split_over_ranks, whole_unknowns
 from rkfx.conditions import Displacement, Pressure
 from rkfx.errors import InputError
 from rkfx.integration.nodal_stabilized import RULES
@@ -196,7 +196,6 @@ def rkpm_column(soil, W, L, ny, rule, points, comm=None):
     d = column_discretization(W, L, *_grid(W, L, ny), rule, comm=comm)
     n = d.particles.num_nodes
     size = 3 * n
-    ranks = d.own is not None  # each rank integrates over its own nodes' cells, collocates at its own nodes
     G = sp.vstack([collocation_rows(d.rk, owned(d, d.bottom), 1, n, 0, size),
                    collocation_rows(d.rk, owned(d, d.sides), 0, n, 0, size),
                    collocation_rows(d.rk, owned(d, d.bottom), None, n, 2 * n, size)]).tocsr()
@@ -204,13 +203,7 @@ def rkpm_column(soil, W, L, ny, rule, points, comm=None):
     rows = evaluate_moving(d.rk, points, nearest).matrix().tocsr()
     # [p at the points..., u_y at the last one] over the whole vector
     rows = sp.vstack([placed(rows[:-1], size, 2 * n), placed(rows[-1:], size, 1, 2)]).tocsr()
-    local = None
-    if ranks:
-        local = rank_unknowns(d, G, comm)
-        G = G[:, local.index].tocsr()
-        sample = local.observer(rows)
-    else:
-        sample = rows.__matmul__
+    local, (G,), sample = split_over_ranks(d, comm, [G], rows)
     return UnsaturatedBiotModel(d.rule, soil, Constraints(G, np.zeros(G.shape[0])), local), sample
 
 
