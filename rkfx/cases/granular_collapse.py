@@ -298,8 +298,9 @@ def plot(results: Results, out: Path) -> list[Path]:
             ax.set_xlabel("x [m]")
             ax.set_ylabel("y [m]")
             ax.legend(fontsize=7, loc="upper right")
-    a_front = fig.add_subplot(grid_[-1, : max(1, len(rules) // 2)] if len(rules) > 1 else grid_[-1, 0])
-    a_ke = fig.add_subplot(grid_[-1, len(rules) // 2:]) if len(rules) > 1 else a_front.twinx()
+    bottom = grid_[-1, :].subgridspec(1, 3)
+    a_front, a_ke, a_law = (fig.add_subplot(bottom[0, k]) for k in range(3))
+    _plot_scaling(a_law, results, rules)
     for k, r in enumerate(results.runs):
         s = r.series
         style = dict(color=f"C{k}", lw=1.3, ls="-" if r.info["rule"] == rules[0] else "--")
@@ -319,6 +320,27 @@ def plot(results: Results, out: Path) -> list[Path]:
                  f"{prm['floor_friction']:g}, {prm['across']} particles across, artificial viscosity beta = "
                  f"{prm['viscosity']:g}" + (f", fixed viscosity {prm['eta']:g} Pa s" if prm.get("eta") else ""))
     return [_cli.save(fig, out / "deposits.png")]
+
+
+def _plot_scaling(ax, results: Results, rules: list[str]) -> None:
+    """The run-outs of the completed runs against the aspect ratio, over the published laws."""
+    aspects = [r.info["aspect"] for r in results.runs]
+    a = np.geomspace(min(0.3, min(aspects)), max(5.0, max(aspects)), 200)
+    ax.loglog(a, lube_runout(a), color="k", ls="--", lw=1.2, label="Lube et al. 2005")
+    ax.loglog(a, bui_runout(a), color="C3", ls="-.", lw=1.0, label="Bui et al. 2015 (rods)")
+    for j, rule in enumerate(rules):
+        done = [r for r in results.runs if r.info["rule"] == rule and r.info["completed"]
+                and not r.info["energy_created"]]
+        if done:
+            ax.loglog([r.info["aspect"] for r in done], [r.info["runout"] for r in done], "os^v"[j % 4],
+                      color=f"C{j}", ms=6, ls="none", label=f"rkpm-{rule}")
+    ticks = [t for t in (0.25, 0.5, 1, 2, 3, 4, 5) if a[0] <= t <= a[-1]]
+    ax.set_xticks(ticks, [f"{t:g}" for t in ticks])
+    ax.set_xticks([], minor=True)
+    ax.set_xlabel("aspect ratio a = H / L")
+    ax.set_ylabel("run-out (L_inf - L) / L")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7)
 
 
 CLAIMS = [
