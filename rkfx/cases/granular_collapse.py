@@ -263,7 +263,7 @@ def plot(results: Results, out: Path) -> list[Path]:
     prm = results.params
     aspects = sorted({r.info["aspect"] for r in results.runs})
     rules = list(dict.fromkeys(r.info["rule"] for r in results.runs))
-    fig = plt.figure(figsize=(7.0 * len(rules), 3.2 * len(aspects) + 3.6), layout="constrained")
+    fig = plt.figure(figsize=(7.0 * max(len(rules), 2), 3.2 * len(aspects) + 3.6), layout="constrained")
     grid_ = fig.add_gridspec(len(aspects) + 1, len(rules))
     H = prm["height"]
     for i, a in enumerate(aspects):
