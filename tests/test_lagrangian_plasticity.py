@@ -161,7 +161,22 @@ def test_viscosity_bad_input():
         _block(viscosity=-1.0)
     with pytest.raises(InputError, match="eta"):
         _block(eta=np.nan)
-    # a fixed viscosity beyond the explicit step's limit at the corner particles (V = h^2 / 4)
-    _block(eta=400.0)
-    with pytest.raises(InputError, match="explicit limit of the viscosity"):
+    # a fixed viscosity beyond the explicit step's limit at the corner particles
+    _block(eta=300.0)
+    with pytest.raises(InputError, match="explicit limit of elasticity and viscosity"):
         _block(eta=600.0)
+
+
+def test_the_step_limit_takes_elasticity_and_viscosity_together():
+    """Without viscosity a step of about h / c is the limit; a viscosity within its own limit
+    2 rho V / eta still lowers it (the damped oscillator's (2 / omega)(sqrt(1 + xi^2) - xi))."""
+    p, model, dt = _block()
+    h = 0.08 / 8
+    c = np.sqrt((SAND.bulk_modulus + 4 * SAND.shear_modulus / 3) / RHO)
+    assert 0.9 * h / c < model._limit < 1.2 * h / c
+    with pytest.raises(InputError, match="explicit limit"):
+        _block(dt=1.3 * h / c)
+    small = (nodal_domains(p).area / model.max_dilation).min()
+    eta = 0.5 * 2 * RHO * small / (0.9 * h / c)  # dt = 0.9 h / c is half of the viscous limit alone
+    with pytest.raises(InputError, match="explicit limit"):
+        _block(dt=0.9 * h / c, eta=eta)

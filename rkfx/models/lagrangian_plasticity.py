@@ -58,6 +58,10 @@ from rkfx.materials.drucker_prager import DruckerPrager
 from rkfx.solvers.central_difference import ExplicitBase
 from rkfx.solvers.fields import single
 
+#: omega sqrt(V) / c of the fastest mode at the smallest particle: on the column collapse's
+#: grid the measured omega_max dt = 0.59 at dt = 0.3 h / c, at the corner (V^0 / 1.25 = h^2 / 7.5).
+OMEGA_V = 0.59 / 0.3 * np.sqrt(1.0 / 7.5)
+
 
 def _gradients(rows, du: np.ndarray) -> np.ndarray:
     """L[:, c, k] = sum_I rows_k(I) du[I, c] for gradient rows with components (d/dx, d/dy)."""
@@ -126,21 +130,21 @@ class LagrangianPlasticity(ExplicitBase):
             raise InputError(f"eta = {eta!r} must be a viscosity >= 0 [Pa s]")
         self.viscosity, self.eta, self.rate = float(viscosity), float(eta), None
         self._rho_c = density * np.sqrt((soil.bulk_modulus + 4.0 * soil.shear_modulus / 3.0) / density)
-        if self.viscosity > 0.0 or self.eta > 0.0:
-            # The explicit viscous stress needs dt <= 2 rho V_L / eta_L at the smallest particle
-            # (V_L down to V_L^0 / max_dilation; measured on the column collapse of
-            # bench/column_collapse.py, corner V^0 = h^2 / 6: a fixed eta ran to the end at 0.28
-            # and 0.56 of it, at 21 and 41 across, and turned the corner inside out within 39
-            # steps at 1.1). It is necessary, not sufficient: at 81 across a run at 0.45 of it
-            # failed near the free top and ran at half the step, though the linear limit of
-            # elasticity and viscosity together, omega dt <= 2 (sqrt(1 + xi^2) - xi) with the
-            # initial omega_max dt = 0.59 at cfl 0.3 and xi = nu / 2 omega, allowed 0.99: a
-            # local failure of the flow, not the step's linear limit.
-            small = self.volume0 / self.max_dilation
-            limit = float(np.min(2.0 * density * small / (self.eta + self.viscosity * self._rho_c * np.sqrt(small))))
-            if dt > limit:
-                raise InputError(f"dt = {dt:.3g} s is beyond the explicit limit of the viscosity, 2 rho V / eta = "
-                                 f"{limit:.3g} s at the smallest particle; reduce dt, eta or viscosity")
+        # The explicit step's linear limit at the smallest particle (V_L down to V_L^0 /
+        # max_dilation), elasticity and viscosity together: omega dt <= 2 (sqrt(1 + xi^2) - xi)
+        # with xi = nu / 2 omega, nu = eta_L / (rho V_L) the viscous rate (alone: dt <= 2 / nu)
+        # and omega = OMEGA_V c / sqrt(V_L) (alone: dt <= 2 / omega). OMEGA_V is calibrated on
+        # the column of bench/column_collapse.py: the largest eigenvalue of M^-1 K at the start
+        # is omega_max dt = 0.59 at dt = 0.3 h / c, at the top corner (V^0 = h^2 / 6), so a step
+        # beyond about h / c is refused. With a fixed eta that column ran to the end at 0.28
+        # and 0.56 of the viscous limit (21 and 41 across) and turned the corner inside out
+        # within 39 steps at 1.1. Necessary, not sufficient: at 81 across a run at 0.59 of
+        # this limit (0.45 of the viscous one) failed near the free top, a local failure of the
+        # flow, and ran at half the step.
+        self._limit = self._stable_step(density)
+        if dt > self._limit:
+            raise InputError(f"dt = {dt:.3g} s is beyond the explicit limit of elasticity and viscosity at the "
+                             f"smallest particle, {self._limit:.3g} s; reduce dt (or eta, viscosity)")
         self.particle_mass = self.density * self.volume
         self.layout = single("u", 2, 2, n)
         self.essential = ()
@@ -156,6 +160,15 @@ class LagrangianPlasticity(ExplicitBase):
         self.yielded = np.zeros(n, bool)
         self.contact: WallContact | None = None
         self._rebuild(fresh=True)
+
+    def _stable_step(self, density: float) -> float:
+        """The linear limit of the explicit step at the smallest particle (see ``__init__``)."""
+        small = self.volume0 / self.max_dilation
+        c = self._rho_c / density
+        omega = OMEGA_V * c / np.sqrt(small)
+        nu = (self.eta + self.viscosity * self._rho_c * np.sqrt(small)) / (density * small)
+        xi = nu / (2.0 * omega)
+        return float(np.min(2.0 / omega * (np.sqrt(1.0 + xi * xi) - xi)))
 
     # -- the approximation in the current configuration
 
