@@ -138,7 +138,7 @@ class LagrangianPlasticity(ExplicitBase):
         # is omega_max dt = 0.59 at dt = 0.3 h / c, at the top corner (V^0 = h^2 / 6), so a step
         # beyond about h / c is refused. With a fixed eta that column ran to the end at 0.28
         # and 0.56 of the viscous limit (21 and 41 across) and turned the corner inside out
-        # within 39 steps at 1.1. Necessary, not sufficient: at 81 across a run at 0.59 of
+        # within 39 steps at 1.1. Necessary, not sufficient: at 81 across a run at 0.60 of
         # this limit (0.45 of the viscous one) failed near the free top, a local failure of the
         # flow, and ran at half the step.
         self._limit = self._stable_step(density)
