@@ -24,8 +24,9 @@ References (``verification.granular_runout``): Lube et al. (2005), (L_inf - L) /
 a = 2.3 and 1.9 a^(2/3) above; Bui et al. (2015)'s aluminium rods, which keep their height at
 the wall below a = 0.65 and run out farther above it.
 
-Measures, per run: the run-out (L_inf - L) / L from the farthest particle on the floor side,
-its relative difference from Lube et al.'s, the height at the wall (the highest particle within
+Measures, per run: the run-out (L_inf - L) / L from the deposit's front (its farthest particle
+not cut off by a gap along x wider than a support; particles thrown beyond it are counted as
+``detached``), its relative difference from Lube et al.'s, the height at the wall (the highest particle within
 one spacing of it) over H, how far the run got (a rule may fail: a particle turned inside out)
 and why it stopped, whether the kinetic energy ever exceeded the work gravity has done (energy
 created: an unstable rule throwing particles about), the kinetic energy at the end and how far the front moved in the last tenth
