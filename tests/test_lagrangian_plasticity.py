@@ -173,7 +173,7 @@ def test_the_step_limit_takes_elasticity_and_viscosity_together():
     p, model, dt = _block()
     h = 0.08 / 8
     c = np.sqrt((SAND.bulk_modulus + 4 * SAND.shear_modulus / 3) / RHO)
-    assert 0.9 * h / c < model._limit < 1.2 * h / c
+    assert 0.9 * h / c < model.stable_step < 1.2 * h / c
     with pytest.raises(InputError, match="explicit limit"):
         _block(dt=1.3 * h / c)
     small = (nodal_domains(p).area / model.max_dilation).min()

@@ -86,7 +86,9 @@ class LagrangianPlasticity(ExplicitBase):
             they move with the particles (the corrected rules integrate N_I n over them).
         soil: The Drucker-Prager law.
         density: rho [kg/m^3].
-        dt: The time step of the run [s] (the walls' penalty and friction use it).
+        dt: The time step of the run [s] (the walls' penalty and friction use it); refused
+            beyond ``stable_step``, the linear limit of elasticity and viscosity together at the
+            smallest particle [s].
         rule: A nodal rule of ``rkfx.integration.nodal_stabilized.RULES``.
         walls: Rigid walls (``rkfx.assembly.rigid_walls.Wall``).
         gravity: (g_x, g_y) [m/s^2].
@@ -141,10 +143,10 @@ class LagrangianPlasticity(ExplicitBase):
         # within 39 steps at 1.1. Necessary, not sufficient: at 81 across a run at 0.60 of
         # this limit (0.45 of the viscous one) failed near the free top, a local failure of the
         # flow, and ran at half the step.
-        self._limit = self._stable_step(density)
-        if dt > self._limit:
+        self.stable_step = self._linear_limit(density)
+        if dt > self.stable_step:
             raise InputError(f"dt = {dt:.3g} s is beyond the explicit limit of elasticity and viscosity at the "
-                             f"smallest particle, {self._limit:.3g} s; reduce dt (or eta, viscosity)")
+                             f"smallest particle, {self.stable_step:.3g} s; reduce dt (or eta, viscosity)")
         self.particle_mass = self.density * self.volume
         self.layout = single("u", 2, 2, n)
         self.essential = ()
@@ -161,7 +163,7 @@ class LagrangianPlasticity(ExplicitBase):
         self.contact: WallContact | None = None
         self._rebuild(fresh=True)
 
-    def _stable_step(self, density: float) -> float:
+    def _linear_limit(self, density: float) -> float:
         """The linear limit of the explicit step at the smallest particle (see ``__init__``)."""
         small = self.volume0 / self.max_dilation
         c = self._rho_c / density
