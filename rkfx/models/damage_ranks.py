@@ -17,7 +17,8 @@ on the rank's local vectors as it would serially; per step the ranks exchange:
 * with the nonlocal equivalent strain (``rkfx.fracture.nonlocal_average``), the strains and
   failed flags of the particles within R of the rank's own (two neighbour-only halo exchanges
   over that wider ghost layer), which the averages of the rank's allowed particles read;
-* the energies and the history samples (all-reduces of a few numbers).
+* the energies (one all-reduce per ``SETTLE_EVERY`` steps of
+  ``rkfx.solvers.central_difference``) and the history samples.
 
 The constraint rows are replicated (the columns of G are ghosts everywhere), so every rank
 solves the same small projection. Every strain, force and damage update is the serial

@@ -27,7 +27,9 @@ Energies per step: kinetic 1/2 v^T M v; internal = work of f_int (trapezoidal in
 plus dissipated energy; exact 1/2 d^T K d for a linear force); external work of f_ext;
 work of the constraint forces, the impulses M (v+ - v-) of the two projections of a step
 over dt (zero for fixed supports). ``balance`` = kinetic + internal - external - constraint
-- initial kinetic stays near zero.
+- initial kinetic stays near zero. On MPI ranks each step's increments are summed over the
+ranks in one all-reduce per ``SETTLE_EVERY`` steps (and at outputs, checkpoints and the
+end), which gives the sums of a per-step all-reduce with fewer synchronizations.
 
 Stability: dt < 2 / omega_max (``rkfx.assembly.smeared_strain.stable_time_step``, ``max_frequency``).
 
@@ -58,6 +60,7 @@ from rkfx.solvers.fields import FieldLayout, single
 from rkfx.solvers.model import Constraints, no_constraints
 
 ENERGIES = ("kinetic", "internal", "external", "constraint")
+SETTLE_EVERY = 16  # steps whose energies a distributed run sums over the ranks at once
 
 
 # --------------------------------------------------------------------------- kernels
@@ -482,6 +485,21 @@ class _Projection:
         return np.concatenate(out)
 
 
+def _added(energy: np.ndarray, inc: np.ndarray, dt: float) -> np.ndarray:
+    """The energies after a step with increments ``inc`` (the kinetic energy is the step's own;
+    the constraint work's increment is an impulse times a displacement, over dt)."""
+    return np.array([inc[0], energy[1] + inc[1], energy[2] + inc[2], energy[3] + inc[3] / dt])
+
+
+def _check_finite(energies: np.ndarray, first: int, dt: float) -> None:
+    """Raise at the first of the rows ``energies`` (steps from ``first`` on) that is not finite."""
+    bad = np.flatnonzero(~np.all(np.isfinite(energies), axis=1))
+    if bad.size:
+        step = first + int(bad[0])
+        raise InputError(f"the solution blew up at step {step} (t = {step * dt:.4g} s); reduce dt below "
+                         "the stable step (stable_time_step / max_frequency)")
+
+
 def _vector(f, n: int, what: str) -> np.ndarray:
     f = np.ascontiguousarray(f, dtype=np.float64)
     if f.shape != (n,):
@@ -510,6 +528,9 @@ class Workspace:
         if self.share is not None and self.owned.shape != (n,):
             raise InputError(f"the model's share marks {self.owned.size} unknowns as owned or ghost; it has {n}")
         self.d_new, self.a_new, self.vh, self.dd = (np.empty(n) for _ in range(4))
+        # On ranks the energy increments of up to SETTLE_EVERY steps wait for one all-reduce.
+        self.unsettled = np.empty((SETTLE_EVERY, len(ENERGIES)))
+        self.pending = 0
         self.zeros = np.zeros(n)
         self.no_dv = np.empty(0)
 
@@ -520,6 +541,22 @@ class Workspace:
     def total(self, values: np.ndarray) -> np.ndarray:
         """Energies of this rank's unknowns summed over the ranks (as is on one)."""
         return values if self.share is None else np.asarray(self.share.sum(values), float)
+
+    def settle(self, s: "ExplicitState", history: np.ndarray, done: int, dt: float) -> None:
+        """On ranks: sum the energy increments of the steps since the last settlement over
+        the ranks (one all-reduce for all of them), add them to ``s.energy`` step by step (the
+        sums of a per-step all-reduce) and write the energies of those steps to ``history``
+        up to row ``done``. Raises if they blew up (collective: every rank settles at the same
+        steps and sees the same sums)."""
+        k, self.pending = self.pending, 0
+        if k == 0:
+            return
+        inc = self.total(np.ascontiguousarray(self.unsettled[:k]))
+        first = done - k + 1
+        for j in range(k):
+            s.energy = _added(s.energy, inc[j], dt)
+            history[first + j] = s.energy
+        _check_finite(history[first:done + 1], first, dt)
 
     @property
     def files(self) -> RankFiles:
@@ -579,9 +616,12 @@ class CentralDifference:
             # Constraint force over the step: the impulses of the half-step projection and of
             # the full-step one at its end (each carries half of it for a steady reaction).
             dv = proj.combined(dv, proj.project(s.v, proj.velocity_target(t_next, dt)))
-        inc = work.total(_energy_increments(s.v, mass, work.dd, s.f_int, f_int, s.f_ext, f_ext, dv, work.owned))
-        e = s.energy
-        s.energy = np.array([inc[0], e[1] + inc[1], e[2] + inc[2], e[3] + inc[3] / dt])
+        inc = _energy_increments(s.v, mass, work.dd, s.f_int, f_int, s.f_ext, f_ext, dv, work.owned)
+        if work.share is None:
+            s.energy = _added(s.energy, inc, dt)
+        else:  # summed over the ranks when settled (Workspace.settle)
+            work.unsettled[work.pending] = inc
+            work.pending += 1
         s.d, work.d_new = work.d_new, s.d
         s.a, work.a_new = work.a_new, s.a
         s.f_int, s.f_ext = f_int, f_ext
@@ -646,13 +686,16 @@ class CentralDifference:
             self.advance(model, s, work)
             done = step + 1
             hist_t[done] = s.time
-            hist_e[done] = s.energy
-            if not np.all(np.isfinite(s.energy)):
-                raise InputError(f"the solution blew up at step {done} (t = {s.time:.4g} s); reduce dt below "
-                                 "the stable step (stable_time_step / max_frequency)")
-            if output_every and (done % output_every == 0 or done == num_steps):
+            output = bool(output_every) and (done % output_every == 0 or done == num_steps)
+            checkpoint = bool(checkpoint_every) and done % checkpoint_every == 0
+            if work.share is None:
+                hist_e[done] = s.energy
+                _check_finite(hist_e[done:done + 1], done, dt)
+            elif output or checkpoint or done == num_steps or work.pending == len(work.unsettled):
+                work.settle(s, hist_e, done, dt)
+            if output:
                 record(s)
-            if checkpoint_every and done % checkpoint_every == 0:
+            if checkpoint:
                 save_run(checkpoint_dir, s.arrays(dt) | {"history_time": hist_t[:done + 1],
                                                          "history_energy": hist_e[:done + 1]}, model, recorder,
                          comm=files.writer)
