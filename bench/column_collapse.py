@@ -54,11 +54,10 @@ def main() -> None:
     ap.add_argument("--height", type=float, default=0.1, help="column height H [m] (aspect ratio a = H / L)")
     args = ap.parse_args()
     width, height = args.width, args.height
-    h = width / (args.nx - 1)
     soil = DruckerPrager(E=0.84e6, nu=0.3, phi=19.8, c=0.0, psi=0.0)
-    model, dt, p = column(width, height, args.nx, None, soil, 2650.0, 9.81, rule=args.rule,
-                          floor_friction=args.floor_friction, cfl=args.cfl, support=args.support,
-                          viscosity=args.viscosity, eta=args.eta)
+    model, dt, p, h = column(width, height, args.nx, None, soil, 2650.0, 9.81, rule=args.rule,
+                             floor_friction=args.floor_friction, cfl=args.cfl, support=args.support,
+                             viscosity=args.viscosity, eta=args.eta)
     steps = int(np.ceil(args.t_end / dt))
     print(f"{len(p.x)} particles, h = {h:.4g} m, dt = {dt:.3g} s, {steps} steps, rule {args.rule}, "
           f"a = {args.support} h, viscosity {args.viscosity}, eta {args.eta} Pa s", flush=True)

@@ -136,7 +136,8 @@ def column(width: float, height: float, nx: int, ny: int | None, soil: DruckerPr
            rule: str, floor_friction: float, cfl: float = 0.3, support: float = 2.0, viscosity: float = 0.0,
            eta: float = 0.0):
     """A column of nx x ny particles at rest in its geostatic state against the wall at x = 0 on the
-    floor y = 0, as the model of a collapse; returns (model, dt, particles). The support is
+    floor y = 0, as the model of a collapse; returns (model, dt, particles, h), h the spacing
+    along x. The support is
     ``support`` spacings, the step ``cfl`` h / c (c the elastic P-wave speed); ``ny=None``: the
     rows whose spacing is nearest to the spacing h along x."""
     h = width / (nx - 1)
@@ -150,7 +151,7 @@ def column(width: float, height: float, nx: int, ny: int | None, soil: DruckerPr
     walls = [Wall((0, 0), (0, 1), floor_friction, "floor"), Wall((0, 0), (1, 0), 0.0, "wall")]
     model = LagrangianPlasticity(p.x, nodal_domains(p).area, support * h, p.boundary_edges, soil, rho, dt, rule=rule,
                                  walls=walls, stress=stress, gravity=(0.0, -gravity), viscosity=viscosity, eta=eta)
-    return model, dt, p
+    return model, dt, p, h
 
 
 def front(model, width: float) -> float:
@@ -200,10 +201,9 @@ def _collapse(aspect, rule, prm, ck) -> Run:
     soil = DruckerPrager(E=prm["E"], nu=prm["nu"], phi=prm["phi"], c=prm["cohesion"], psi=prm["psi"])
     height = prm["height"]
     width, nx, ny = grid(height, aspect, prm["across"])
-    model, dt, p = column(width, height, nx, ny, soil, prm["rho"], prm["gravity"], rule=rule,
-                          floor_friction=prm["floor_friction"], cfl=prm["cfl"], viscosity=prm["viscosity"],
-                          eta=prm["eta"])
-    h = width / (nx - 1)
+    model, dt, p, h = column(width, height, nx, ny, soil, prm["rho"], prm["gravity"], rule=rule,
+                             floor_friction=prm["floor_friction"], cfl=prm["cfl"], viscosity=prm["viscosity"],
+                             eta=prm["eta"])
     steps = int(np.ceil(prm["t_end"] / dt))
     history = History(model, width, h)
     label = f"rkpm-{rule} a={aspect:g}"
