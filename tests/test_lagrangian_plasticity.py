@@ -180,3 +180,30 @@ def test_the_step_limit_takes_elasticity_and_viscosity_together():
     eta = 0.5 * 2 * RHO * small / (0.9 * h / c)  # dt = 0.9 h / c is half of the viscous limit alone
     with pytest.raises(InputError, match="explicit limit"):
         _block(dt=0.9 * h / c, eta=eta)
+
+
+@pytest.mark.parametrize("rule", ["nsni", "dni"])
+@pytest.mark.parametrize("viscosity, eta", [(0.0, 0.0), (0.3, 0.0), (0.0, 50.0)])
+def test_the_step_limit_is_where_the_step_becomes_unstable(rule, viscosity, eta):
+    """The limit is measured on the rows, not estimated: a free elastic block excited by a small
+    random stress rings within its amplitude at 0.97 of ``stable_step`` and blows up at 1.03
+    (no dilation bound to allow for, so the limit is that of the initial rows)."""
+    p = structured(0.08, 0.08, 9, 9)
+    h = 0.01
+    soil = DruckerPrager(E=1e6, nu=0.3, phi=30.0, c=1e6)  # stays elastic
+    stress = 1e-3 * np.random.default_rng(1).standard_normal((81, 4))
+    stress[:, 2] = 0.0
+
+    def block(dt):
+        return LagrangianPlasticity(p.x, nodal_domains(p).area, 2 * h, p.boundary_edges, soil, RHO, dt, rule=rule,
+                                    stress=stress, gravity=(0.0, 0.0), max_dilation=1.000001, viscosity=viscosity,
+                                    eta=eta)
+
+    limit = block(1e-9).stable_step
+    stable = block(0.97 * limit)
+    CentralDifference(0.97 * limit).run(stable, 300)
+    assert np.abs(stable.x - p.x).max() < 1e-8
+    beyond = block(limit)
+    beyond.dt = 1.03 * limit  # beyond the limit, which the constructor refuses
+    with pytest.raises(InputError, match="turned inside out"):
+        CentralDifference(1.03 * limit).run(beyond, 300)

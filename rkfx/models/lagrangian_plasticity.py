@@ -48,6 +48,7 @@ the VC-corrected rules still fail (non-symmetric systems).
 from collections.abc import Mapping, Sequence
 
 import numpy as np
+import scipy.sparse.linalg as spla
 
 from rkfx.approximation.semi_lagrangian import evaluate_moving, moved, moving_rk
 from rkfx.assembly.rigid_walls import Wall, WallContact, wall_forces
@@ -58,14 +59,40 @@ from rkfx.materials.drucker_prager import DruckerPrager
 from rkfx.solvers.central_difference import ExplicitBase
 from rkfx.solvers.fields import single
 
-#: omega sqrt(V) / c of the fastest mode at the smallest particle: on the column collapse's
-#: grid the measured omega_max dt = 0.59 at dt = 0.3 h / c, at the corner (V^0 / 1.25 = h^2 / 7.5).
-OMEGA_V = 0.59 / 0.3 * np.sqrt(1.0 / 7.5)
+def _largest_eigenvalue(force_of_strain, model: "LagrangianPlasticity") -> float:
+    """|lambda|_max of M^-1 K for the linear force ``force_of_strain(Voigt strains of the
+    points)`` of a displacement on ``model``'s current rows (ARPACK from a seeded start; dense
+    for a few particles)."""
+    mass = model.lumped_mass()
+    size = mass.size
+
+    def apply(v):
+        strain = jaumann.strain_increment(_gradients(model.rule.trial, np.reshape(v, (-1, 2))), 1.0)
+        return force_of_strain(strain).ravel() / mass
+
+    if size <= 64:
+        values = np.linalg.eigvals(np.column_stack([apply(e) for e in np.eye(size)]))
+    else:
+        op = spla.LinearOperator((size, size), matvec=apply, dtype=np.float64)
+        start = np.random.default_rng(0).standard_normal(size)
+        try:
+            values = spla.eigs(op, k=1, which="LM", v0=start, tol=1e-4, return_eigenvectors=False)
+        except spla.ArpackNoConvergence as err:
+            if not len(err.eigenvalues):
+                raise InputError("the explicit step's limit: ARPACK found no eigenvalue of the particles' "
+                                 "operator; check the particles (a degenerate set?)") from err
+            values = err.eigenvalues
+    return float(np.abs(values).max())
 
 
 def _gradients(rows, du: np.ndarray) -> np.ndarray:
     """L[:, c, k] = sum_I rows_k(I) du[I, c] for gradient rows with components (d/dx, d/dy)."""
     return np.transpose(rows @ du, (0, 2, 1))
+
+
+def _rate(d: np.ndarray) -> np.ndarray:
+    """2 D in the stress layout (xx, yy, zz, xy) from Voigt (d_xx, d_yy, gamma_xy)."""
+    return np.column_stack([2.0 * d[:, 0], 2.0 * d[:, 1], np.zeros(len(d)), d[:, 2]])
 
 
 def _divergence(rows, stress: np.ndarray) -> np.ndarray:
@@ -87,8 +114,8 @@ class LagrangianPlasticity(ExplicitBase):
         soil: The Drucker-Prager law.
         density: rho [kg/m^3].
         dt: The time step of the run [s] (the walls' penalty and friction use it); refused
-            beyond ``stable_step``, the linear limit of elasticity and viscosity together at the
-            smallest particle [s].
+            beyond ``stable_step``, the linear limit of elasticity and viscosity together on the
+            initial rows, the particles shrunk to the dilation bound [s].
         rule: A nodal rule of ``rkfx.integration.nodal_stabilized.RULES``.
         walls: Rigid walls (``rkfx.assembly.rigid_walls.Wall``).
         gravity: (g_x, g_y) [m/s^2].
@@ -132,21 +159,6 @@ class LagrangianPlasticity(ExplicitBase):
             raise InputError(f"eta = {eta!r} must be a viscosity >= 0 [Pa s]")
         self.viscosity, self.eta, self.rate = float(viscosity), float(eta), None
         self._rho_c = density * np.sqrt((soil.bulk_modulus + 4.0 * soil.shear_modulus / 3.0) / density)
-        # The explicit step's linear limit at the smallest particle (V_L down to V_L^0 /
-        # max_dilation), elasticity and viscosity together: omega dt <= 2 (sqrt(1 + xi^2) - xi)
-        # with xi = nu / 2 omega, nu = eta_L / (rho V_L) the viscous rate (alone: dt <= 2 / nu)
-        # and omega = OMEGA_V c / sqrt(V_L) (alone: dt <= 2 / omega). OMEGA_V is calibrated on
-        # the column of bench/column_collapse.py: the largest eigenvalue of M^-1 K at the start
-        # is omega_max dt = 0.59 at dt = 0.3 h / c, at the top corner (V^0 = h^2 / 6), so a step
-        # beyond about h / c is refused. With a fixed eta that column ran to the end at 0.28
-        # and 0.56 of the viscous limit (21 and 41 across) and turned the corner inside out
-        # within 39 steps at 1.1. Necessary, not sufficient: at 81 across a run at 0.60 of
-        # this limit (0.45 of the viscous one) failed near the free top, a local failure of the
-        # flow, and ran at half the step.
-        self.stable_step = self._linear_limit(density)
-        if dt > self.stable_step:
-            raise InputError(f"dt = {dt:.3g} s is beyond the explicit limit of elasticity and viscosity at the "
-                             f"smallest particle, {self.stable_step:.3g} s; reduce dt (or eta, viscosity)")
         self.particle_mass = self.density * self.volume
         self.layout = single("u", 2, 2, n)
         self.essential = ()
@@ -162,15 +174,36 @@ class LagrangianPlasticity(ExplicitBase):
         self.yielded = np.zeros(n, bool)
         self.contact: WallContact | None = None
         self._rebuild(fresh=True)
+        self.stable_step = self._linear_limit()
+        if dt > self.stable_step:
+            raise InputError(f"dt = {dt:.3g} s is beyond the explicit limit of elasticity and viscosity on the "
+                             f"particles, {self.stable_step:.3g} s; reduce dt (or eta, viscosity)")
 
-    def _linear_limit(self, density: float) -> float:
-        """The linear limit of the explicit step at the smallest particle (see ``__init__``)."""
-        small = self.volume0 / self.max_dilation
-        c = self._rho_c / density
-        omega = OMEGA_V * c / np.sqrt(small)
-        nu = (self.eta + self.viscosity * self._rho_c * np.sqrt(small)) / (density * small)
+    def _linear_limit(self) -> float:
+        """The linear limit of the explicit step [s], elasticity and viscosity together, on the
+        rows of the current configuration, its particles shrunk to the bound V_L^0 / max_dilation.
+
+        The central difference step of a mode of frequency omega and viscous rate nu is stable
+        for omega dt <= 2 (sqrt(1 + xi^2) - xi), xi = nu / 2 omega (alone: dt <= 2 / omega,
+        dt <= 2 / nu). omega^2 is the largest eigenvalue (in size) of M^-1 K, K the force of the
+        elastic stress of a displacement (NSNI: with its stress-gradient terms), and nu that of
+        M^-1 K_eta, K_eta the force of its viscous stress 2 eta_L D with eta_L taken at the
+        shrunk volume. Both operators scale as 1 / V when the particles shrink together by a
+        factor, so omega^2 and nu are taken times ``max_dilation``. Necessary, not sufficient:
+        the rows change as the particles move (docs/large_deformation.md).
+        """
+        shrunk = self.volume / self.max_dilation
+        elastic = self.max_dilation * _largest_eigenvalue(
+            lambda e: self._force(s := self.soil.elastic_increment(e), s), self)
+        omega = np.sqrt(elastic)
+        nu = 0.0
+        if self.viscosity > 0.0 or self.eta > 0.0:
+            nu = self.max_dilation * _largest_eigenvalue(
+                lambda e: self._force(None, self._with_viscous(0.0, _rate(e), shrunk)), self)
+        if omega == 0.0:
+            return 2.0 / nu if nu > 0.0 else np.inf
         xi = nu / (2.0 * omega)
-        return float(np.min(2.0 / omega * (np.sqrt(1.0 + xi * xi) - xi)))
+        return float(2.0 / omega * (np.sqrt(1.0 + xi * xi) - xi))
 
     # -- the approximation in the current configuration
 
@@ -207,31 +240,42 @@ class LagrangianPlasticity(ExplicitBase):
         if np.any(du):
             self._advance(du)
             self.d_last = d.copy()
-        r = self.rule
-        total = self.stress
-        if self.rate is not None:
-            if self.viscosity > 0.0:
-                total = total + (self._rho_c * self.rate) * (self.viscosity * np.sqrt(self.volume))[:, None]
-            if self.eta > 0.0:
-                total = total + self.eta * self.rate
-        f = _divergence(r.test, r.weights[:, None] * total)
-        if r.moments is not None:
-            tau = self.implicit @ self.stress  # (n, 3, 4): [sigma, d sigma / dx, d sigma / dy] at the particles
-            for k, rows in enumerate((r.trial_x, r.trial_y)):
-                f += _divergence(rows, r.moments[:, k:k + 1] * tau[:, 1 + k])
+        f = self._force(self.stress, self._with_viscous(self.stress, self.rate, self.volume))
         self.contact = None
         if self.walls:
-            dx = r.values @ du
+            dx = self.rule.values @ du
             self.contact = wall_forces(self.walls, self.x, dx[:, 0], self.particle_mass, self.dt, self.kappa)
-            f -= r.values.matrix().T @ self.contact.force
+            f -= self.rule.values.matrix().T @ self.contact.force
         return f.ravel()
+
+    def _with_viscous(self, stress: np.ndarray, rate: np.ndarray | None, volume: np.ndarray) -> np.ndarray:
+        """sigma + 2 eta_L D: the viscous stress of the rate of deformation ``rate`` (the stress
+        layout (xx, yy, zz, xy), D_xy as gamma_xy / 2) at particles of ``volume``, eta_L =
+        beta rho c sqrt(V_L) + eta."""
+        if rate is None:
+            return stress
+        if self.viscosity > 0.0:
+            stress = stress + (self._rho_c * rate) * (self.viscosity * np.sqrt(volume))[:, None]
+        if self.eta > 0.0:
+            stress = stress + self.eta * rate
+        return stress
+
+    def _force(self, stress: np.ndarray, total: np.ndarray) -> np.ndarray:
+        """The internal force (n, 2) of the particle stresses ``total`` on the current rule, with
+        the NSNI terms of the stress gradients of ``stress`` (``None``: without them)."""
+        r = self.rule
+        f = _divergence(r.test, r.weights[:, None] * total)
+        if r.moments is not None and stress is not None:
+            tau = self.implicit @ stress  # (n, 3, 4): [sigma, d sigma / dx, d sigma / dy] at the particles
+            for k, rows in enumerate((r.trial_x, r.trial_y)):
+                f += _divergence(rows, r.moments[:, k:k + 1] * tau[:, 1 + k])
+        return f
 
     def _advance(self, du: np.ndarray) -> None:
         r = self.rule
         L = _gradients(r.trial, du)
         if self.viscosity > 0.0 or self.eta > 0.0:
-            d = jaumann.strain_increment(L, 1.0 / self.dt)
-            self.rate = np.column_stack([2.0 * d[:, 0], 2.0 * d[:, 1], np.zeros(len(d)), d[:, 2]])
+            self.rate = _rate(jaumann.strain_increment(L, 1.0 / self.dt))
         rotated = jaumann.rotated(self.stress, L, 1.0)
         step = self.soil.update(rotated, jaumann.strain_increment(L, 1.0), self.plastic_strain)
         self.stress, self.plastic_strain, self.yielded = step.stress, step.plastic_strain, step.yielded
