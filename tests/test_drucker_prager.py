@@ -95,3 +95,34 @@ def test_tangent_increment_is_the_rate_of_the_return():
     assert load.sum() > 5
     assert np.abs(rate - tangent).max() < 1e-4 * np.abs(tangent).max()
     assert np.array_equal(soil.tangent_increment(sig, np.zeros(len(sig), bool), d), soil.elastic_increment(d))
+
+
+def test_algorithmic_tangent_is_the_derivative_of_a_finite_return():
+    """After a finite step that yields, d sigma / d(d eps) of the whole return matches central
+    differences of ``update`` (the continuum tangent does not: it misses the curvature term)."""
+    soil = DruckerPrager(E=1e6, nu=0.3, phi=30.0, c=500.0, psi=10.0)
+    rng = np.random.default_rng(5)
+    m = 60
+    start = np.tile([-2e3, -5e3, -3e3, 0.0], (m, 1))
+    d = rng.normal(size=(m, 3)) * 3e-3
+    step = soil.update(start, d, np.zeros(m))
+    trial_i1 = invariants(start + soil.elastic_increment(d))[0]
+    # returned to the cone, from inside the apex's mean stress or cut off in tension first (not
+    # returned to the apex itself, where the tangent is 0)
+    cone = step.yielded & (invariants(step.stress)[1] > 1.0)
+    assert np.sum(cone & (trial_i1 < soil.apex)) > 10 and np.sum(cone & (trial_i1 > soil.apex)) > 5
+    d_lambda = np.sqrt(3.0) * step.plastic_strain
+    tangent = soil.algorithmic_tangent(step.stress, step.yielded, d_lambda)
+    h = 1e-8
+    for j in range(3):
+        e = np.zeros((m, 3))
+        e[:, j] = h
+        fd = (soil.update(start, d + e, np.zeros(m)).stress - soil.update(start, d - e, np.zeros(m)).stress) / (2 * h)
+        scale = np.abs(fd[cone]).max()
+        assert np.abs(fd[cone] - tangent[cone, :, j]).max() < 1e-5 * scale
+        continuum = soil.tangent_increment(step.stress, step.yielded, e / h)
+        assert np.abs(fd[cone] - continuum[cone]).max() > 1e-2 * scale
+    elastic = ~step.yielded
+    assert elastic.any()
+    unit = soil.algorithmic_tangent(step.stress, step.yielded, d_lambda)[elastic]
+    assert np.allclose(unit[:, :, 0], soil.elastic_increment(np.tile([1.0, 0.0, 0.0], (elastic.sum(), 1))))

@@ -165,6 +165,54 @@ class DruckerPrager:
         out[:, :3] += i1[:, None] / 3.0
         return StressUpdate(out, np.asarray(plastic_strain, float) + dlam / np.sqrt(3.0), yielded)
 
+    def algorithmic_tangent(self, stress: np.ndarray, yielded: np.ndarray, d_lambda: np.ndarray) -> np.ndarray:
+        """d sigma / d(d eps) of ``update`` at its result, shape ``(m, 4, 3)`` [Pa]: the stress
+        components (xx, yy, zz, xy) against the strain increment's (xx, yy, gamma_xy), for a
+        Newton iteration on a finite step.
+
+        ``stress`` and ``yielded`` are the update's, ``d_lambda`` its plastic multiplier
+        (sqrt(3) times the growth of the equivalent plastic strain). With n = s / q and
+        q* = q + G d lambda the trial's sqrt(J_2):
+
+        * on the cone the return's s = s* (1 - G d lambda / q*) adds to the continuum tangent
+          (``tangent_increment``) -(G d lambda / q*) (2 G dev d eps - G (n : d eps) n): the
+          deviatoric stiffness across the radial direction falls by that factor;
+        * after the tension cut-off (a trial beyond the apex, recognized by I_1 + 9 K a_psi
+          d lambda above it) the mean stress of the trial is gone: sigma = s* beta_0 +
+          (apex - 9 K a_psi q* / H) I / 3 with beta_0 = 9 K a_phi a_psi / H, H = G + 9 K a_phi
+          a_psi, so d sigma = beta_0 2 G dev d eps - (3 K a_psi G / H) (n : d eps) I;
+        * at the apex 0, and D at the points that stayed elastic.
+        """
+        stress = np.asarray(stress, float)
+        d_lambda = np.asarray(d_lambda, float)
+        m = len(stress)
+        out = np.empty((m, 4, 3))
+        for j in range(3):
+            unit = np.zeros((m, 3))
+            unit[:, j] = 1.0
+            out[:, :, j] = self.tangent_increment(stress, yielded, unit)
+        i1, q, s = invariants(stress)
+        G, K, a, b = self.shear_modulus, self.bulk_modulus, self.a_phi, self.a_psi
+        tiny = 1e-9 * np.maximum(np.abs(i1), max(self.k_c, 1e-300))
+        on = np.asarray(yielded, bool) & (q > tiny) & (d_lambda > 0.0)
+        cut = on & (i1 + 9.0 * K * b * d_lambda >= self.apex - tiny)
+        cone = on & ~cut
+        dev = np.zeros((4, 3))                                  # 2 G dev(d eps) per unit strain
+        dev[:3, :2] = -2.0 * G / 3.0
+        dev[0, 0] += 2.0 * G
+        dev[1, 1] += 2.0 * G
+        dev[3, 2] = G
+        n = s / np.where(q > 0, q, 1.0)[:, None]                # (xx, yy, zz, xy)
+        n_de = n[:, [0, 1, 3]]                                  # n : d eps per unit strain (gamma engineering)
+        if cone.any():
+            factor = G * d_lambda[cone] / (q[cone] + G * d_lambda[cone])
+            out[cone] -= factor[:, None, None] * (dev - G * n[cone, :, None] * n_de[cone, None, :])
+        if cut.any():
+            h = G + 9.0 * K * a * b
+            ones = np.array([1.0, 1.0, 1.0, 0.0])
+            out[cut] = (9.0 * K * a * b / h) * dev - (3.0 * K * b * G / h) * ones[None, :, None] * n_de[cut, None, :]
+        return out
+
     def tangent_increment(self, stress: np.ndarray, yielded: np.ndarray, d_strain: np.ndarray) -> np.ndarray:
         """C_T : d eps at the stresses of an update, shape ``(m, 4)`` [Pa].
 
