@@ -118,3 +118,58 @@ def test_the_contributions_of_a_split_of_the_points_add_up_to_the_whole_model(ru
     assert scale(sum(m.rate_force(x, v) for m in parts) - f) <= 1e-12 * scale(f)
     for a, b in zip(whole.rate_tangents(), zip(*(m.rate_tangents() for m in parts))):
         assert abs(sum(b) - a).max() <= 1e-12 * abs(a).max()
+
+
+def _plastic(rule="nsni", ramp=None, c=20.0):
+    from rkfx.materials.drucker_prager import DruckerPrager
+    d = column_discretization(0.2, 1.0, 3, 11, rule)
+    soil = UnsaturatedSoil(SAND, VanGenuchten(S_rw=0.0842, n=2.0, beta=0.7))
+    dp = DruckerPrager(E=SAND.E, nu=SAND.nu, phi=30.0, c=c, psi=10.0)
+    return d, dp, UnsaturatedBiotModel(d.rule, soil, no_constraints(3 * d.particles.num_nodes), weight="full",
+                                       plasticity=dp, ramp=ramp)
+
+
+@pytest.mark.parametrize("rule", ["nsni", "dni"])
+def test_plastic_jacobian_is_the_derivative(rule):
+    """With a Drucker-Prager skeleton on a step that yields most points, the Jacobian (the
+    return map's algorithmic tangent, the load factor on the weight and the pore pressure's
+    force) is the derivative of the residual; the committed history moves only on commit."""
+    d, dp, m = _plastic(rule, ramp=lambda t: 0.7)
+    x, _ = state(d)
+    x[:2 * d.particles.num_nodes] *= 30.0  # strains of a few 1e-3: past the cone at most points
+    r0 = m.residual(x, 0.0)
+    upd = m._trial[1]
+    assert upd.yielded.mean() > 0.5
+    K = m.tangent(x, 0.0).toarray()
+    n = d.particles.num_nodes
+    rng = np.random.default_rng(2)
+    for _ in range(3):
+        dir_ = np.r_[1e-6 * rng.standard_normal(2 * n), 1.0 * rng.standard_normal(n)]
+        h = 1e-3
+        fd = (m.residual(x + h * dir_, 0.0) - m.residual(x - h * dir_, 0.0)) / (2 * h)
+        for s in (slice(0, 2 * n), slice(2 * n, None)):
+            assert np.abs(fd[s] - (K @ dir_)[s]).max() <= 1e-6 * np.abs(fd[s]).max()
+    assert not np.any(m.plastic_state[1])  # nothing committed yet
+    m.residual(x, 0.0)
+    m.commit()
+    stress, plastic = m.plastic_state
+    assert np.all(dp.yield_function(stress) <= 1e-9 * np.abs(stress).max()) and plastic.max() > 0
+    saved = {k: v.copy() for k, v in m.state().items()}
+    r1 = m.residual(2.0 * x, 0.0)  # from the committed state
+    m.residual(1.5 * x, 0.0)
+    m.commit()
+    assert not np.array_equal(m.residual(2.0 * x, 0.0), r1)  # from the new one: another path
+    m.restore(saved)
+    assert np.array_equal(m.residual(2.0 * x, 0.0), r1)
+
+
+def test_plasticity_needs_the_whole_weight_and_the_same_elasticity():
+    from rkfx.materials.drucker_prager import DruckerPrager
+    d = column_discretization(0.2, 1.0, 3, 11)
+    soil = UnsaturatedSoil(SAND, Liakopoulos())
+    with pytest.raises(InputError, match="weight='full'"):
+        UnsaturatedBiotModel(d.rule, soil, no_constraints(3 * d.particles.num_nodes),
+                             plasticity=DruckerPrager(E=SAND.E, nu=SAND.nu, phi=30.0))
+    with pytest.raises(InputError, match="differ from the medium"):
+        UnsaturatedBiotModel(d.rule, soil, no_constraints(3 * d.particles.num_nodes), weight="full",
+                             plasticity=DruckerPrager(E=2 * SAND.E, nu=SAND.nu, phi=30.0))

@@ -31,8 +31,13 @@ sum V (grad^c N)^T k S rho_w g. The Jacobian is exact except for d(1/Q)/dp, take
 differences (``rkfx.materials.retention.storage_slope``); its blocks are sums of weighted row
 products on patterns found once (``rkfx.assembly.weighted_forms``). Essential conditions are
 collocation rows at boundary nodes.
+
+With ``plasticity`` the skeleton is Drucker-Prager: K u becomes sum V B^c^T sigma''(u) + the
+elastic NSNI expansion terms, sigma'' the return map of each point's committed stress by its
+strain increment, the Jacobian the return's algorithmic tangent; ``ramp`` scales the skeleton's
+loads (gravity) by a factor lambda(t), the path a plastic state is loaded along.
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -43,6 +48,7 @@ from rkfx.assembly.seepage_face import SeepageFace
 from rkfx.assembly.weighted_forms import WeightedForm, placed
 from rkfx.errors import InputError
 from rkfx.integration.nodal_stabilized import NodalIntegration
+from rkfx.materials.drucker_prager import DruckerPrager
 from rkfx.materials.retention import Retention, storage, storage_slope
 from rkfx.models.explicit_poroelasticity import Constituents
 from rkfx.parallel.unknowns import LocalUnknowns
@@ -116,11 +122,22 @@ class UnsaturatedBiotModel(Stateless):
         weight: ``"change"`` (the skeleton carries rho - rho_sat) or ``"full"`` (all of rho).
         load: A constant external force over the whole model's vector (with ``local``, each
             rank adds its owned entries), or ``None``.
+        plasticity: A Drucker-Prager skeleton (``rkfx.materials.drucker_prager``, the medium's E
+            and nu) in place of the elastic one, with ``weight="full"``: sigma'' at each point
+            is the return map of its committed stress by the strain increment of the step, and
+            the Jacobian takes its algorithmic tangent; the NSNI expansion terms stay elastic
+            (a stabilization). History: the points' strain, stress and equivalent plastic
+            strain, committed with each step. ``None``: linear elastic.
+        ramp: A load factor lambda(t) on the skeleton's loads, its weight, the pore
+            pressure's force alpha S_w p and ``load`` (gravity scaled by lambda, the flow
+            equation unchanged): the path along which a plastic skeleton takes its load.
+            ``None``: 1.
     """
 
     def __init__(self, rule: NodalIntegration, soil: UnsaturatedSoil, constraints: Constraints,
                  local: LocalUnknowns | None = None, seepage: SeepageFace | None = None, weight: str = "change",
-                 load: np.ndarray | None = None):
+                 load: np.ndarray | None = None, plasticity: DruckerPrager | None = None,
+                 ramp=None):
         if weight not in WEIGHTS:
             raise InputError(f"weight = {weight!r}: choose {' or '.join(WEIGHTS)}")
         self.local = local
@@ -152,6 +169,9 @@ class UnsaturatedBiotModel(Stateless):
                 self.expansion.append((rule.moments[:, j], [rows.matrix(c).tocsr() for c in range(2)]))
         self.g = np.array([0.0, -soil.gravity])
         m = soil.medium
+        self.plasticity, self.ramp = plasticity, ramp
+        if plasticity is not None:
+            self._plastic_skeleton(rule, plasticity, weight)
         # the skeleton's body load per unit volume is [rho_0 + n rho_w S_w] g
         self._rho_0 = -m.porosity * m.rho_f if weight == "change" else (1.0 - m.porosity) * m.rho_s
         whole = 3 * n if local is None else int(local.index.max(initial=-1)) + 1
@@ -164,6 +184,25 @@ class UnsaturatedBiotModel(Stateless):
         self._load = None if load is None else np.asarray(load, float)
         self._at = None
         self._forms()
+
+    def _plastic_skeleton(self, rule: NodalIntegration, plasticity: DruckerPrager, weight: str) -> None:
+        """The strain rows, the elastic stabilization alone in ``K`` and the committed history."""
+        if not isinstance(plasticity, DruckerPrager):
+            raise InputError(f"plasticity {plasticity!r} is not a DruckerPrager law")
+        if weight != "full":
+            raise InputError("plasticity needs weight='full': the skeleton's whole stress, from an unstressed start")
+        elastic = self.soil.medium.material.elastic
+        if not np.isclose(plasticity.E, elastic.E) or not np.isclose(plasticity.nu, elastic.nu):
+            raise InputError(f"the plasticity's E = {plasticity.E:g}, nu = {plasticity.nu:g} differ from the medium's "
+                             f"E = {elastic.E:g}, nu = {elastic.nu:g}; give the same elastic constants")
+        b_test, b_trial = strain_matrix(rule.test), strain_matrix(rule.trial)
+        self._b_test = [b_test[c::3].tocsr() for c in range(3)]
+        self._b_trial = [b_trial[c::3].tocsr() for c in range(3)]
+        smoothed = replace(rule, moments=None, trial_x=None, trial_y=None)
+        self.K = (self.K - nodal_forms.stiffness(smoothed, elastic.D())).tocsr()  # NSNI's expansion terms alone
+        m = len(rule.weights)
+        self._committed = (np.zeros((m, 3)), np.zeros((m, 4)), np.zeros(m))
+        self._trial = None
 
     def _forms(self) -> None:
         """The patterns of the Jacobian (``tangent``) and of the rate derivatives."""
@@ -179,6 +218,8 @@ class UnsaturatedBiotModel(Stateless):
         pairs += [(on_p(r), N) for _, rows in self.expansion for r in rows]
         if self._face is not None:
             pairs += [(on_p(self._face), on_p(self._face))]                     # d(kappa <p>_+)/dp
+        if self.plasticity is not None:                                         # B^T C_T B
+            pairs += [(placed(bt, size), placed(br, size)) for bt in self._b_test for br in self._b_trial]
         self._tangent = WeightedForm(pairs, (size, size), constant=placed(sp.vstack([self.K, sp.csr_matrix((n, 2 * n))]),
                                                                            size))
         self._rate_x = WeightedForm([(N, N)], (size, size))
@@ -232,8 +273,15 @@ class UnsaturatedBiotModel(Stateless):
         c = soil.coefficients(pL)
         k = m.k * c["kr"]
         grad = [t @ P for t in self.trial]
-        r_u = self.K @ u - self.div_test.T @ (V * soil.alpha * c["S"] * pL)
-        body = V * (self._rho_0 + m.porosity * m.rho_f * c["S"])
+        lam = self._factor(t)
+        r_u = self.K @ u - self.div_test.T @ (lam * V * soil.alpha * c["S"] * pL)
+        if self.plasticity is not None:
+            strain, stress, plastic = self._committed
+            eps = np.column_stack([b @ u for b in self._b_trial])
+            self._trial = (eps, self.plasticity.update(stress, eps - strain, plastic))
+            sig = self._trial[1].stress
+            r_u = r_u + sum(b.T @ (V * sig[:, k]) for b, k in zip(self._b_test, (0, 1, 3)))
+        body = lam * V * (self._rho_0 + m.porosity * m.rho_f * c["S"])
         r_u[1::2] -= self.NT @ (body * self.g[1])
         if self.g[0]:
             r_u[0::2] -= self.NT @ (body * self.g[0])
@@ -249,21 +297,36 @@ class UnsaturatedBiotModel(Stateless):
             r_p = r_p + self._face.T @ (self.seepage.weights * self.seepage.penalty * np.maximum(face, 0.0))
         self._at = (pL, c, grad, second, face)
         r = np.r_[r_u, r_p]
-        return r if self._load is None else r - self._load
+        return r if self._load is None else r - lam * self._load
+
+    def _factor(self, t: float) -> float:
+        """The load factor lambda(t) (1 without a ramp)."""
+        if self.ramp is None:
+            return 1.0
+        lam = float(self.ramp(t))
+        if not np.isfinite(lam):
+            raise InputError(f"ramp({t:g}) = {lam!r}: the load factor must be finite")
+        return lam
 
     def tangent(self, x: np.ndarray, t: float) -> sp.csr_matrix:
         V, soil = self.V, self.soil
         m = soil.medium
         pL, c, grad, second, face = self._at
         k, dk = m.k * c["kr"], m.k * c["dkr"]
-        w = [-V * soil.alpha * (c["S"] + c["dS"] * pL)]
-        w += [-V * m.porosity * m.rho_f * c["dS"] * self.g[j] for j in self._components]
+        lam = self._factor(t)
+        w = [-lam * V * soil.alpha * (c["S"] + c["dS"] * pL)]
+        w += [-lam * V * m.porosity * m.rho_f * c["dS"] * self.g[j] for j in self._components]
         w += [V * k] * 2
         w += [mom * k for mom, rows in self.expansion for _ in rows]
         w += [V * (dk * (grad[j] - c["S"] * m.rho_f * self.g[j]) - k * c["dS"] * m.rho_f * self.g[j]) for j in range(2)]
         w += [mom * dk * d[j] for (mom, _), d in zip(self.expansion, second) for j in range(2)]
         if face is not None:
             w += [self.seepage.weights * self.seepage.penalty * (face > 0.0)]
+        if self.plasticity is not None:
+            upd = self._trial[1]
+            d_lambda = np.sqrt(3.0) * (upd.plastic_strain - self._committed[2])
+            ct = self.plasticity.algorithmic_tangent(upd.stress, upd.yielded, d_lambda)
+            w += [V * ct[:, i, j] for i in (0, 1, 3) for j in range(3)]
         return self._tangent(w)
 
     def rate_force(self, x: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -288,3 +351,26 @@ class UnsaturatedBiotModel(Stateless):
 
     def constraints(self, t: float) -> Constraints:
         return self._constraints
+
+    # ------------------------------------------------------------------ history (plasticity)
+
+    @property
+    def plastic_state(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """With plasticity, the committed sigma'' (num_points, 4) (xx, yy, zz, xy) [Pa] and
+        equivalent plastic strain (num_points,) at the integration points; else ``None``."""
+        return None if self.plasticity is None else self._committed[1:]
+
+    def commit(self) -> None:
+        if self.plasticity is not None and self._trial is not None:
+            eps, upd = self._trial
+            self._committed = (eps, upd.stress, upd.plastic_strain)
+
+    def state(self) -> dict[str, np.ndarray]:
+        if self.plasticity is None:
+            return {}
+        return dict(zip(("strain", "stress", "plastic_strain"), self._committed))
+
+    def restore(self, arrays) -> None:
+        if self.plasticity is not None:
+            self._committed = tuple(np.array(arrays[k]) for k in ("strain", "stress", "plastic_strain"))
+            self._trial = None
