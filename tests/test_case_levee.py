@@ -51,9 +51,27 @@ def test_the_elastic_state_is_beyond_drucker_prager_in_the_saturated_core(quick)
         assert r.info["strength_max_x"] > 3.5 and r.info["strength_max_y"] < 0.2
 
 
+@pytest.mark.parametrize("water", [0.2, 0.8])
+def test_the_elastic_plastic_state_holds_at_a_low_river_and_flows_at_a_high_one(water):
+    """Stage 1b at h = 0.1 m: gravity raised to 1 in 20 steps with the Drucker-Prager return map
+    in the steady seepage. Every point ends inside the cone. With the river at 0.2 m the crest
+    settles about as the elastic levee (measured 1.19 mm against 0.90 mm, 1.22 mm at h = 0.05);
+    at 0.8 m the downstream half flows (25.8 mm against 0.57 mm elastic, 87 mm at h = 0.05: held
+    by the stabilization alone, no static equilibrium; docs/large_deformation.md)."""
+    r = levee.run(methods=("rkpm",), h=0.1, water=water, plastic=True).runs[0]
+    info = r.info
+    assert info["lambda_reached"] == 1.0 and info["plastic_yield_excess"] < 1e-9, info
+    ratio = info["plastic_crest_settlement"] / info["crest_settlement"]
+    assert (ratio < 1.6) if water == 0.2 else (ratio > 20.0), ratio
+    assert len(r.series["ramp_lambda"]) == levee.PARAMS["ramp_steps"].default
+    if water == 0.8:
+        assert info["plastic_strain_max_x"] > 3.5 and info["plastic_strain_max"] > 0.03
+
+
 def test_bad_parameters_are_refused_in_one_line():
     prm = {k: v.default for k, v in levee.PARAMS.items()}
     for bad, match in ((dict(water=1.2), "water"), (dict(h=0.3), "too coarse"), (dict(rule="gauss"), "rule"),
-                       (dict(conductivity=0.0), "conductivity"), (dict(S_rw=1.5), "S_rw")):
+                       (dict(conductivity=0.0), "conductivity"), (dict(S_rw=1.5), "S_rw"),
+                       (dict(ramp_steps=0), "ramp_steps"), (dict(plastic="yes"), "plastic")):
         with pytest.raises(InputError, match=match):
             levee.check(**{**prm, **bad})

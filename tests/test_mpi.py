@@ -62,12 +62,14 @@ def test_contributions_assemble_at_their_owners(ranks):
 @pytest.mark.mpi
 @pytest.mark.skipif(not MPIEXEC.exists() and shutil.which("mpiexec") is None, reason="no mpiexec")
 @pytest.mark.parametrize("ranks", [2, 3])
-@pytest.mark.parametrize("case", ["mandel", "liakopoulos", "wave_column", "wave_column --set fpp=true", "levee"])
+@pytest.mark.parametrize("case", ["mandel", "liakopoulos", "wave_column", "wave_column --set fpp=true",
+                                  "levee --set plastic=true"])
 def test_quick_runs_on_ranks_are_the_serial_run(tmp_path, case, ranks):
     """``mandel``, ``liakopoulos``, ``wave_column`` and ``levee --quick`` (RKPM: Biot on SCNI,
     unsaturated u-p on NSNI, explicit u-p dynamics on NSNI and DNI, the levee's steady seepage
-    through a seepage face on gmsh nodes; each rank integrating over its own nodes' cells; the
-    explicit one also with the pressure projection's storage solve) on 1 rank and on 2 or 3:
+    through a seepage face on gmsh nodes and its elastic-plastic state; each rank integrating
+    over its own nodes' cells; the explicit one also with the pressure projection's storage
+    solve) on 1 rank and on 2 or 3:
     every series within 1e-10 of its largest value (the
     early-time overshoots are round-off sized themselves: compared absolutely), the same Newton
     iterations and steps."""

@@ -240,7 +240,7 @@ ROWS: list[Row] = [
     Row("too big for memory", "liakopoulos", ("--set", "ny=99999991")),
     *_case_rows("levee", [("river above the crest", "water=1.5"), ("mesh too coarse for the slopes", "h=0.3"),
                           ("unknown nodal rule", "rule=gauss"), ("zero conductivity", "conductivity=0"),
-                          ("residual saturation 1", "S_rw=1")]),
+                          ("residual saturation 1", "S_rw=1"), ("no steps of the plastic ramp", "ramp_steps=0")]),
     Row("too big for memory", "levee", ("--set", "h=1e-5")),
     *_case_rows("granular_collapse", [("aspect ratio zero", "aspects=0"), ("too few particles across", "across=3"),
                                       ("unknown nodal rule", "rules=gauss"), ("step beyond stability", "cfl=0.9")]),

@@ -45,6 +45,17 @@ and rms difference over the interior nodes relative to FEM's largest stress comp
 its mobilized strength sqrt(J_2) / (k_c - a_phi I_1) of Drucker-Prager (1: at yield): where it
 exceeds 1 and where it is largest (at the downstream toe, where the seed's shear band starts).
 
+Stage 1b (``--set plastic=true``, RKPM): the elastic-plastic state in that seepage
+(``plastic_state``). From u = 0 and the steady pressures, gravity (the skeleton's weight, the
+pore pressure's force and the river's traction) rises with a load factor from 0 to 1 in
+``ramp_steps`` backward Euler steps, the effective stress following the Drucker-Prager return
+map (``UnsaturatedBiotModel(..., plasticity=, ramp=)``); reported: the load factor reached
+(a Newton failure after 8 cuts ends the stage there), the crest's settlement against it, the
+equivalent plastic strain and the largest yield function (<= 0: admissible). The FEM baseline
+stays elastic. With the assumed dimensions the levee holds the river at 0.2 m but not at 0.8
+m: there the downstream half flows, its settlement growing as the stabilization's stiffness
+falls with h (docs/large_deformation.md).
+
 Stage 2, the dynamic collapse from this state on moving particles (``rkfx.models.
 lagrangian_plasticity`` with the u-p flow), is not in this case yet: under NSNI the plastic
 flow of the collapse still goes unstable at the advancing toe (docs/large_deformation.md).
@@ -52,7 +63,7 @@ flow of the collapse still goes unstable at the advancing toe (docs/large_deform
 Parameters and units (``--set NAME=VALUE``): E [Pa], nu [-], rho_s, rho_w [kg/m^3], porosity
 [-], conductivity [m/s], K_s, K_w [Pa], gravity [m/s^2], S_rw [-], vg_n [-], vg_beta [1/m],
 phi [deg], cohesion [Pa], height, crest, slope_up, slope_down, water [m], h [m], rule,
-first_step [s].
+first_step [s], plastic, ramp_steps.
 
     python -m rkfx.cases.levee [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
 """
@@ -72,14 +83,16 @@ from rkfx.assembly.weighted_forms import placed
 from rkfx.cases import _cli, _preflight
 from rkfx.cases._cli import Param, Results, Run
 from rkfx.cases._nodal_up import edge_load, nodal_discretization, owned, split_over_ranks, whole_unknowns
-from rkfx.errors import InputError
+from rkfx.errors import InputError, SolverError
 from rkfx.integration.nodal_stabilized import RULES
 from rkfx.materials.drucker_prager import DruckerPrager, invariants
 from rkfx.materials.retention import VanGenuchten
 from rkfx.models.explicit_poroelasticity import Constituents, collocation_rows
 from rkfx.models.unsaturated_poroelasticity import UnsaturatedBiotModel, UnsaturatedSoil
 from rkfx.report.claims import Claim
+from rkfx.solvers.integrate import integrate
 from rkfx.solvers.model import Constraints
+from rkfx.solvers.newmark import backward_euler
 from rkfx.solvers.steady import steady_state
 
 NAME = "levee"
@@ -107,6 +120,8 @@ PARAMS = {
     "h": Param(0.05, "mesh size of the particles and the triangles [m]"),
     "rule": Param("nsni", "nodal integration rule of RKPM"),
     "first_step": Param(0.01, "first pseudo-time step of the steady march [s]"),
+    "plastic": Param(False, "RKPM also computes the elastic-plastic state in the steady seepage (stage 1b)"),
+    "ramp_steps": Param(20, "steps of the load factor from 0 to 1 in the elastic-plastic stage [-]"),
 }
 QUICK = {"h": 0.1}
 
@@ -129,7 +144,8 @@ def sand(**params) -> UnsaturatedSoil:
 
 
 def check(*, E, nu, rho_s, rho_w, porosity, conductivity, K_s, K_w, gravity, S_rw, vg_n, vg_beta, phi, cohesion,
-          height, crest, slope_up, slope_down, water, h, rule, first_step, **_) -> None:
+          height, crest, slope_up, slope_down, water, h, rule, first_step, plastic=False, ramp_steps=20,
+          **_) -> None:
     """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
     for name, v in (("conductivity", conductivity), ("height", height), ("crest", crest), ("slope_up", slope_up),
                     ("slope_down", slope_down), ("h", h), ("first_step", first_step), ("gravity", gravity)):
@@ -144,6 +160,10 @@ def check(*, E, nu, rho_s, rho_w, porosity, conductivity, K_s, K_w, gravity, S_r
                          f"({water}), the dry slope's ({height - water:.4g}) and the crest ({crest})")
     if rule not in RULES:
         raise InputError(f"unknown nodal rule {rule!r}; choose from {', '.join(RULES)}")
+    if not isinstance(plastic, (bool, np.bool_)):
+        raise InputError(f"plastic = {plastic!r}: give true or false")
+    if int(ramp_steps) != ramp_steps or ramp_steps < 1:
+        raise InputError(f"ramp_steps = {ramp_steps!r} must be a whole number >= 1")
 
 
 def memory_need(methods, *, height, crest, slope_up, slope_down, h, **_) -> _preflight.Need:
@@ -201,9 +221,11 @@ def _samplers(levee: Levee, nodes: np.ndarray, crest_mid: np.ndarray):
     return np.vstack([nodes, levee.on_downstream(ys), crest_mid[None, :]]), ys
 
 
-def rkpm_levee(p, soil: UnsaturatedSoil, levee: Levee, h: float, rule: str, points: np.ndarray, comm=None):
+def rkpm_levee(p, soil: UnsaturatedSoil, levee: Levee, h: float, rule: str, points: np.ndarray, comm=None,
+               plasticity: DruckerPrager | None = None, ramp=None):
     """The RKPM model of the levee on particles ``p`` and its sampler of [p..., u_x..., u_y...]
-    at ``points`` (on ranks: collective, every rank gets all of them)."""
+    at ``points`` (on ranks: collective, every rank gets all of them); with ``plasticity`` the
+    skeleton is elastic-plastic, its loads scaled by ``ramp(t)``."""
     d = nodal_discretization(p, h, rule, comm)
     n, x = p.num_nodes, p.x
     size = 3 * n
@@ -222,7 +244,8 @@ def rkpm_levee(p, soil: UnsaturatedSoil, levee: Levee, h: float, rule: str, poin
     rows = sp.vstack([placed(rows, size, 2 * n), placed(rows, size, 0, 2), placed(rows, size, 1, 2)]).tocsr()
     local, (G,), sample = split_over_ranks(d, comm, [G], rows,
                                            touching=sp.vstack([G, placed(face.matrix(), size, 2 * n), rows]))
-    model = UnsaturatedBiotModel(d.rule, soil, Constraints(G, g), local, seepage=face, weight="full", load=load)
+    model = UnsaturatedBiotModel(d.rule, soil, Constraints(G, g), local, seepage=face, weight="full", load=load,
+                                 plasticity=plasticity, ramp=ramp)
     return model, sample, d
 
 
@@ -266,6 +289,51 @@ def fem_levee(mesh_data, soil: UnsaturatedSoil, levee: Levee, h: float, points: 
     return model, sample, strains
 
 
+class _Ramp:
+    """The load factor and the crest's settlement of every committed step of the plastic stage."""
+
+    def __init__(self, sample, points: int):
+        self.sample, self.points, self.rows = sample, points, []
+
+    def record(self, s) -> None:
+        self.rows.append((s.t, float(-self.sample(s.x)[2 * self.points:][-1])))
+
+    def arrays(self):
+        return {"ramp": np.array(self.rows)}
+
+    def restore(self, a) -> None:
+        self.rows = [tuple(r) for r in a["ramp"]]
+
+
+def plastic_state(p, soil: UnsaturatedSoil, levee: Levee, h: float, rule: str, points: np.ndarray, comm,
+                  elastic_x: np.ndarray, dp: DruckerPrager, steps: int) -> dict:
+    """Stage 1b: the skeleton's elastic-plastic equilibrium in the steady seepage of ``elastic_x``.
+
+    From u = 0 and the steady pressures, the skeleton's loads (its weight, the pore pressure's
+    force alpha S_w p and the river's traction, i.e. gravity) rise with a load factor lambda
+    from 0 to 1 in ``steps`` backward Euler steps, the stress following the Drucker-Prager return
+    map. A step whose Newton fails is cut (up to 8 times); if it still fails, the stage ends
+    there: beyond the lambda reached the levee has no static equilibrium. Returns the lambda
+    reached, the crest's settlement against lambda, and the committed stress and equivalent
+    plastic strain at the nodes."""
+    model, sample, d = rkpm_levee(p, soil, levee, h, rule, points, comm, plasticity=dp, ramp=lambda t: t)
+    x0 = np.array(elastic_x, float)
+    x0[:2 * model.n] = 0.0
+    stepper = backward_euler()
+    ramp = _Ramp(sample, len(points))
+    why = "reached lambda = 1"
+    try:
+        run = integrate(stepper, model, np.linspace(0.0, 1.0, steps + 1), start=stepper.start(model, x0),
+                        recorder=ramp, comm=comm, max_cuts=8)
+        newton, cuts = run.newton_iterations, run.cuts
+    except SolverError as err:
+        why, newton, cuts = f"stopped: {err}", None, None
+    stress, plastic = (_at_nodes(d, a, comm) for a in model.plastic_state)
+    rows = np.array(ramp.rows) if ramp.rows else np.zeros((0, 2))
+    return {"lambda_reached": float(rows[-1, 0]) if len(rows) else 0.0, "why": why, "newton_iterations": newton,
+            "cuts": cuts, "ramp": rows, "stress": stress, "plastic_strain": plastic}
+
+
 def _rkpm_strains(model, x: np.ndarray) -> np.ndarray:
     """(eps_xx, eps_yy, gamma_xy) of RKPM at its integration points, by the rule's trial gradients."""
     return (strain_matrix(model.rule.trial) @ x[:2 * model.n]).reshape(-1, 3)
@@ -295,12 +363,12 @@ def _at_nodes(d, values: np.ndarray, comm) -> np.ndarray:
 def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.3, rho_s=2700.0, rho_w=1000.0, porosity=0.46,
         conductivity=5.0e-4, K_s=1.0e22, K_w=1.0e9, gravity=9.806, S_rw=0.0842, vg_n=2.0, vg_beta=0.7, phi=20.0,
         cohesion=300.0, height=1.0, crest=0.5, slope_up=2.0, slope_down=2.0, water=0.8, h=0.05, rule="nsni",
-        first_step=0.01) -> Results:
+        first_step=0.01, plastic=False, ramp_steps=20) -> Results:
     """The initial state by both methods on one triangulation; see the module docstring."""
     prm = dict(E=E, nu=nu, rho_s=rho_s, rho_w=rho_w, porosity=porosity, conductivity=conductivity, K_s=K_s, K_w=K_w,
                gravity=gravity, S_rw=S_rw, vg_n=vg_n, vg_beta=vg_beta, phi=phi, cohesion=cohesion, height=height,
                crest=crest, slope_up=slope_up, slope_down=slope_down, water=water, h=h, rule=rule,
-               first_step=first_step)
+               first_step=first_step, plastic=plastic, ramp_steps=ramp_steps)
     check(**prm)
     soil = _soil(E, nu, rho_s, rho_w, porosity, conductivity, K_s, K_w, gravity, S_rw, vg_n, vg_beta)
     levee = Levee(height, crest, slope_up, slope_down, water)
@@ -357,6 +425,20 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.3, rho_s=2700
             info.update(strength_max=float(ratio.max()), strength_max_x=float(p.x[worst, 0]),
                         strength_max_y=float(p.x[worst, 1]), yielded_nodes=int(np.sum(ratio >= 1.0)))
             found[method] = (pv[:n], ux[:n], uy[:n], stress)
+            if plastic and method == "rkpm":
+                stage = plastic_state(p, soil, levee, h, rule, points, comm, x,
+                                      DruckerPrager(E=E, nu=nu, phi=phi, c=cohesion), int(ramp_steps))
+                eps_p = stage["plastic_strain"]
+                dp = DruckerPrager(E=E, nu=nu, phi=phi, c=cohesion)
+                worst = int(np.argmax(eps_p))
+                ramp = stage["ramp"]
+                info.update(lambda_reached=stage["lambda_reached"], plastic_why=stage["why"],
+                            plastic_newton_iterations=stage["newton_iterations"], plastic_cuts=stage["cuts"],
+                            plastic_crest_settlement=float(ramp[-1, 1]) if len(ramp) else 0.0,
+                            plastic_strain_max=float(eps_p.max()), plastic_strain_max_x=float(p.x[worst, 0]),
+                            plastic_strain_max_y=float(p.x[worst, 1]), plastic_nodes=int(np.sum(eps_p > 1e-3)),
+                            plastic_yield_excess=float(dp.yield_function(stage["stress"]).max() / dp.k_c))
+                series.update(plastic_strain=eps_p, ramp_lambda=ramp[:, 0], ramp_settlement=ramp[:, 1])
             results.runs.append(Run(label, time.perf_counter() - t0, whole_unknowns(model), series=series, info=info))
         if rank == 0:
             gmsh.model.remove()
@@ -475,7 +557,52 @@ def plot(results: Results, out: Path) -> list[Path]:
                        for r in runs.values())
     fig.suptitle(f"Levee (§6.4.3), initial state: steady seepage under gravity, river at {prm['water']:g} m, "
                  f"h = {prm['h']:g} m, {prm['nodes']} nodes; the crest settles {settle}")
-    return [_cli.save(fig, out / "initial_state.png")]
+    paths = [_cli.save(fig, out / "initial_state.png")]
+    if "rkpm" in runs and "plastic_strain" in runs["rkpm"].series:
+        paths.append(_plot_plastic(runs["rkpm"], tri, outline, prm, plt, out))
+    return paths
+
+
+def _plot_plastic(r, tri, outline, prm, plt, out: Path) -> Path:
+    """The elastic-plastic stage: the equivalent plastic strain and the crest's settlement
+    against the load factor."""
+    from matplotlib.colors import LogNorm  # noqa: PLC0415
+
+    info, s = r.info, r.series
+    fig = plt.figure(figsize=(14, 7.5), layout="constrained")
+    grid = fig.add_gridspec(2, 3, height_ratios=[1.0, 0.9])
+    a_map, a_ramp = fig.add_subplot(grid[0, :]), fig.add_subplot(grid[1, 0])
+    a_map.set_aspect("equal")
+    a_map.plot(outline[:, 0], outline[:, 1], color="k", lw=0.8)
+    eps_p = np.maximum(np.asarray(s["plastic_strain"]), 1e-6)
+    top = max(int(np.ceil(np.log10(eps_p.max()))), -5)
+    c = a_map.tricontourf(tri, eps_p, levels=np.logspace(-6, top, 4 * (top + 6) + 1), norm=LogNorm(), cmap="inferno")
+    a_map.tricontour(tri, np.asarray(s["p"]), levels=[0.0], colors="c", linewidths=1.2)
+    a_map.plot([info["plastic_strain_max_x"]], [info["plastic_strain_max_y"]], "c*", ms=12)
+    fig.colorbar(c, ax=a_map, label="equivalent plastic strain", shrink=0.9, ticks=10.0 ** np.arange(-6, top + 1))
+    a_map.set_xlabel("x [m]")
+    a_map.set_ylabel("y [m]")
+    a_map.set_title(f"{r.method}, elastic-plastic: equivalent plastic strain (largest {info['plastic_strain_max']:.3g} at "
+                    f"the star; above 1e-3 at {info['plastic_nodes']} nodes), water table (cyan)", fontsize=9)
+    a_ramp.plot(np.asarray(s["ramp_lambda"]), 1e3 * np.asarray(s["ramp_settlement"]), "o-", ms=3, color="C3",
+                label="elastic-plastic")
+    a_ramp.plot([0.0, 1.0], [0.0, 1e3 * info["crest_settlement"]], "--", color="0.4", label="elastic")
+    a_ramp.set_xlabel("load factor lambda (gravity)")
+    a_ramp.set_ylabel("crest settlement [mm]")
+    a_ramp.legend(fontsize=8)
+    a_ramp.grid(alpha=0.3)
+    text = fig.add_subplot(grid[1, 1:])
+    text.set_axis_off()
+    text.text(0.0, 0.95, "\n".join([
+        f"river at {prm['water']:g} m, h = {prm['h']:g} m, {prm['nodes']} nodes, {r.method}",
+        f"steady seepage (elastic march), then gravity raised from 0 to 1 in {prm['ramp_steps']} steps",
+        f"load factor reached: {info['lambda_reached']:.3g} ({info['plastic_why'][:90]})",
+        f"crest settlement {1e3 * info['plastic_crest_settlement']:.3g} mm (elastic {1e3 * info['crest_settlement']:.3g} mm)",
+        f"largest yield function f / k_c = {info['plastic_yield_excess']:.2g} (admissible: <= 0)"]), va="top",
+        fontsize=10)
+    fig.suptitle(f"Levee (§6.4.3), stage 1b: the elastic-plastic state in the steady seepage (Drucker-Prager phi "
+                 f"{prm['phi']:g} deg, c {prm['cohesion']:g} Pa)")
+    return _cli.save(fig, out / "plastic_state.png")
 
 
 CLAIMS = [
