@@ -313,7 +313,7 @@ def plastic_state(p, soil: UnsaturatedSoil, levee: Levee, h: float, rule: str, p
     force alpha S_w p and the river's traction, i.e. gravity) rise with a load factor lambda
     from 0 to 1 in ``steps`` backward Euler steps, the stress following the Drucker-Prager return
     map. A step whose Newton fails is cut (up to 8 times); if it still fails, the stage ends
-    there: beyond the lambda reached the levee has no static equilibrium. Returns the lambda
+    there (a sign, not a proof, that no static equilibrium lies beyond). Returns the lambda
     reached, the crest's settlement against lambda, and the committed stress and equivalent
     plastic strain at the nodes."""
     model, sample, d = rkpm_levee(p, soil, levee, h, rule, points, comm, plasticity=dp, ramp=lambda t: t)

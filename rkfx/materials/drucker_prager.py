@@ -178,7 +178,7 @@ class DruckerPrager:
           (``tangent_increment``) -(G d lambda / q*) (2 G dev d eps - G (n : d eps) n): the
           deviatoric stiffness across the radial direction falls by that factor;
         * after the tension cut-off (a trial beyond the apex, recognized by I_1 + 9 K a_psi
-          d lambda above it) the mean stress of the trial is gone: sigma = s* beta_0 +
+          d lambda at or above it) the mean stress of the trial is gone: sigma = s* beta_0 +
           (apex - 9 K a_psi q* / H) I / 3 with beta_0 = 9 K a_phi a_psi / H, H = G + 9 K a_phi
           a_psi, so d sigma = beta_0 2 G dev d eps - (3 K a_psi G / H) (n : d eps) I;
         * at the apex 0, and D at the points that stayed elastic.
