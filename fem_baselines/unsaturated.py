@@ -34,13 +34,14 @@ from fem_baselines.poroelasticity import FemBiotModel, _global_matrix, _global_v
 from rkfx.assembly.seepage_face import check_penalty
 from rkfx.conditions import Condition
 from rkfx.errors import InputError
+from rkfx.models.plastic_points import PlasticPoints
 from rkfx.models.unsaturated_poroelasticity import WEIGHTS, UnsaturatedSoil
 
 #: Names of the coefficient Functions on the quadrature space (``UnsaturatedSoil.coefficients``).
 COEFFICIENTS = ("S", "dS", "kr", "dkr", "iQ", "diQ")
 
 
-class FemUnsaturatedModel(FemBiotModel):
+class FemUnsaturatedModel(PlasticPoints, FemBiotModel):
     """The unsaturated u-p equations on a Taylor-Hood mesh, as a model of ``rkfx.solvers``.
 
     Args:
@@ -54,11 +55,18 @@ class FemUnsaturatedModel(FemBiotModel):
             from the saturated state) or (1 - n) rho_s (``"full"``).
         facet_tags, physical_groups: Of a gmsh mesh (``fem_baselines.gmsh_mesh``), so that
             conditions may name its boundary groups.
+        plasticity: A Drucker-Prager skeleton (the medium's E and nu, ``weight="full"``), as in
+            the RKPM model: sigma'' at each quadrature point the return map of its committed
+            stress by the step's strain increment (``rkfx.materials.drucker_prager``, the same
+            numpy law on a quadrature space), the Jacobian its algorithmic tangent; history
+            committed with each step. ``None``: elastic.
+        ramp: The load factor lambda(t) on the skeleton's loads (weight, the pore pressure's
+            force, the tractions), as in the RKPM model; ``None``: 1.
     """
 
     def __init__(self, mesh: dolfinx.mesh.Mesh, soil: UnsaturatedSoil, conditions: Sequence[Condition],
                  quadrature_degree: int = 4, seepage: tuple | None = None, weight: str = "change",
-                 facet_tags=None, physical_groups=None):
+                 facet_tags=None, physical_groups=None, plasticity=None, ramp=None):
         if weight not in WEIGHTS:
             raise InputError(f"weight = {weight!r}: choose {' or '.join(WEIGHTS)}")
         m = soil.medium
@@ -87,11 +95,15 @@ class FemUnsaturatedModel(FemBiotModel):
         du, dp = ufl.TrialFunction(self.V), ufl.TrialFunction(self.Q)
         flux = grad_p = ufl.grad(p) - S * rho * g
         form = dolfinx.fem.form
-        self._F_u = form((ufl.inner(sigma(u), strain(v)) - alpha * S * p * ufl.div(v)
-                          - (rho_0 + n * rho * S) * ufl.inner(g, v)) * dx)
+        self.plasticity, self.ramp = plasticity, ramp
+        if plasticity is None and ramp is None:
+            self._F_u = form((ufl.inner(sigma(u), strain(v)) - alpha * S * p * ufl.div(v)
+                              - (rho_0 + n * rho * S) * ufl.inner(g, v)) * dx)
+            self._J_uu = form(ufl.inner(sigma(du), strain(v)) * dx)
+            self._J_up = form((-alpha * (S + dS * p) * dp * ufl.div(v) - n * rho * dS * dp * ufl.inner(g, v)) * dx)
+        else:
+            self._plastic_forms(mesh, cell, quadrature_degree, weight, sigma, dx, const, alpha, n, rho, rho_0, g)
         F_p = k * kr * ufl.inner(flux, ufl.grad(q)) * dx
-        self._J_uu = form(ufl.inner(sigma(du), strain(v)) * dx)
-        self._J_up = form((-alpha * (S + dS * p) * dp * ufl.div(v) - n * rho * dS * dp * ufl.inner(g, v)) * dx)
         J_pp = (k * kr * ufl.inner(ufl.grad(dp), ufl.grad(q)) + k * dkr * dp * ufl.inner(grad_p, ufl.grad(q))
                 - k * kr * dS * dp * rho * ufl.inner(g, ufl.grad(q))) * dx
         self._c_p = form(q * (alpha * S * ufl.div(self.vu) + iQ * self.vp) * dx)
@@ -109,8 +121,40 @@ class FemUnsaturatedModel(FemBiotModel):
             F_p = F_p + outflow * q * ds
             J_pp = J_pp + const(kappa) * wet * dp * q * ds
         self._F_p, self._J_pp = form(F_p), form(J_pp)
-        self._kuu = _global_matrix(self._J_uu, self.comm)
+        self._kuu = _global_matrix(self._J_uu, self.comm) if self.plasticity is None else None
         self._q = [form(-k * kr * flux[j] * dx) for j in range(2)]
+
+    def _plastic_forms(self, mesh, cell, degree, weight, sigma, dx, const, alpha, n, rho, rho_0, g) -> None:
+        """F_u and its Jacobian with a load factor, and with plasticity the stress and tangent
+        held on quadrature spaces (Voigt: strain (xx, yy, gamma_xy), stress (xx, yy, xy))."""
+        u, v, du, p = self.uh, ufl.TestFunction(self.V), ufl.TrialFunction(self.V), self.ph
+        S, dS = self.coef["S"], self.coef["dS"]
+        self._lam = lam = const(1.0)
+        form = dolfinx.fem.form
+        loads = -lam * alpha * S * p * ufl.div(v) - lam * (rho_0 + n * rho * S) * ufl.inner(g, v)
+        self._J_up = form(lam * (-alpha * (S + dS * p) * ufl.div(v) - n * rho * dS * ufl.inner(g, v)) *
+                          ufl.TrialFunction(self.Q) * dx)
+        if self.plasticity is None:
+            self._F_u = form((ufl.inner(sigma(u), strain(v)) + loads) * dx)
+            self._J_uu = form(ufl.inner(sigma(du), strain(v)) * dx)
+            return
+
+        def space(shape):
+            return dolfinx.fem.functionspace(mesh, basix.ufl.quadrature_element(cell, value_shape=shape, degree=degree))
+
+        def voigt(w):
+            e = strain(w)
+            return ufl.as_vector([e[0, 0], e[1, 1], 2.0 * e[0, 1]])
+
+        Wv, Wt = space((3,)), space((3, 3))
+        self._eps_at = dolfinx.fem.Expression(voigt(u), Wv.element.interpolation_points)
+        self._eps = dolfinx.fem.Function(Wv)
+        self._sig = dolfinx.fem.Function(Wv)       # (xx, yy, xy) of the trial stress
+        self._ct = dolfinx.fem.Function(Wt)
+        self._F_u = form((ufl.inner(self._sig, voigt(v)) + loads) * dx)
+        self._J_uu = form(ufl.inner(ufl.dot(self._ct, voigt(du)), voigt(v)) * dx)
+        m = self.soil.medium
+        self._plastic_points(self.plasticity, self.ramp, weight, m.E, m.nu, len(self._eps.x.array) // 3)
 
     # ------------------------------------------------------------------ state
 
@@ -134,11 +178,26 @@ class FemUnsaturatedModel(FemBiotModel):
     def residual(self, x: np.ndarray, t: float) -> np.ndarray:
         self._set(x)
         self._t_trial = t
+        if self.plasticity is None and self.ramp is None:
+            r = np.r_[_global_vector(self._F_u, self.comm), _global_vector(self._F_p, self.comm)]
+            return r - self.loads(t)
+        lam = self._factor(t)
+        self._lam.value = lam
+        if self.plasticity is not None:
+            self._eps.interpolate(self._eps_at)
+            stress = self._return_map(self._eps.x.array.reshape(-1, 3).copy())
+            self._sig.x.array[:] = stress[:, [0, 1, 3]].ravel()
         r = np.r_[_global_vector(self._F_u, self.comm), _global_vector(self._F_p, self.comm)]
-        return r - self.loads(t)
+        loads = self.loads(t).copy()
+        loads[:self._n_u] *= lam
+        return r - loads
 
     def tangent(self, x: np.ndarray, t: float) -> sp.csr_matrix:
-        return self._blocks(self._kuu, _global_matrix(self._J_up, self.comm), None,
+        kuu = self._kuu
+        if self.plasticity is not None:
+            self._ct.x.array[:] = self._return_tangent().ravel()
+            kuu = _global_matrix(self._J_uu, self.comm)
+        return self._blocks(kuu, _global_matrix(self._J_up, self.comm), None,
                             _global_matrix(self._J_pp, self.comm))
 
     def rate_force(self, x: np.ndarray, v: np.ndarray) -> np.ndarray:

@@ -55,16 +55,25 @@ def test_the_elastic_state_is_beyond_drucker_prager_in_the_saturated_core(quick)
 def test_the_elastic_plastic_state_holds_at_a_low_river_and_flows_at_a_high_one(water):
     """Stage 1b at h = 0.1 m: gravity raised to 1 in 20 steps with the Drucker-Prager return map
     in the steady seepage. Every point ends inside the cone. With the river at 0.2 m the crest
-    settles about as the elastic levee (measured 1.19 mm against 0.90 mm, 1.22 mm at h = 0.05);
-    at 0.8 m the downstream half flows (25.8 mm against 0.57 mm elastic, 87 mm at h = 0.05: held
-    by the stabilization alone, no static equilibrium; docs/large_deformation.md)."""
-    r = levee.run(methods=("rkpm",), h=0.1, water=water, plastic=True).runs[0]
-    info = r.info
-    assert info["lambda_reached"] == 1.0 and info["plastic_yield_excess"] < 1e-9, info
-    ratio = info["plastic_crest_settlement"] / info["crest_settlement"]
-    assert (ratio < 1.6) if water == 0.2 else (ratio > 20.0), ratio
-    assert len(r.series["ramp_lambda"]) == levee.PARAMS["ramp_steps"].default
-    if water == 0.8:
+    settles about as the elastic levee (measured: RKPM 1.19 mm, 1.22 at h = 0.05; FEM 1.25 mm,
+    elastic 0.90 mm); at 0.8 m RKPM's downstream half flows (25.8 mm against 0.57 mm elastic,
+    87 mm at h = 0.05: held by the stabilization alone, where the FEM's Newton fails near lambda
+    = 0.4; docs/large_deformation.md)."""
+    methods = ("rkpm", "fem") if water == 0.2 else ("rkpm",)
+    if "fem" in methods:
+        pytest.importorskip("dolfinx_solver")
+    runs = {r.method.split("-")[0]: r for r in levee.run(methods=methods, h=0.1, water=water, plastic=True).runs}
+    for r in runs.values():
+        info = r.info
+        assert info["lambda_reached"] == 1.0 and info["plastic_yield_excess"] < 1e-9, info
+        ratio = info["plastic_crest_settlement"] / info["crest_settlement"]
+        assert (ratio < 1.6) if water == 0.2 else (ratio > 20.0), (r.method, ratio)
+        assert len(r.series["ramp_lambda"]) == levee.PARAMS["ramp_steps"].default
+    if water == 0.2:
+        rk, fem = (runs[k].info["plastic_crest_settlement"] for k in ("rkpm", "fem"))
+        assert abs(rk - fem) < 0.08 * fem, (rk, fem)
+    else:
+        info = runs["rkpm"].info
         assert info["plastic_strain_max_x"] > 3.5 and info["plastic_strain_max"] > 0.03
 
 

@@ -51,6 +51,7 @@ from rkfx.integration.nodal_stabilized import NodalIntegration
 from rkfx.materials.drucker_prager import DruckerPrager
 from rkfx.materials.retention import Retention, storage, storage_slope
 from rkfx.models.explicit_poroelasticity import Constituents
+from rkfx.models.plastic_points import PlasticPoints
 from rkfx.parallel.unknowns import LocalUnknowns
 from rkfx.solvers.fields import layout
 from rkfx.solvers.model import Constraints, Stateless
@@ -103,7 +104,7 @@ def _divergence(rows) -> sp.csr_matrix:
     return (b[0::3] + b[1::3]).tocsr()
 
 
-class UnsaturatedBiotModel(Stateless):
+class UnsaturatedBiotModel(PlasticPoints, Stateless):
     """The unsaturated u-p equations on one nodal rule (see the module docstring).
 
     Args:
@@ -169,9 +170,9 @@ class UnsaturatedBiotModel(Stateless):
                 self.expansion.append((rule.moments[:, j], [rows.matrix(c).tocsr() for c in range(2)]))
         self.g = np.array([0.0, -soil.gravity])
         m = soil.medium
-        self.plasticity, self.ramp = plasticity, ramp
+        self._plastic_points(plasticity, ramp, weight, m.E, m.nu, len(rule.weights))
         if plasticity is not None:
-            self._plastic_skeleton(rule, plasticity, weight)
+            self._plastic_skeleton(rule)
         # the skeleton's body load per unit volume is [rho_0 + n rho_w S_w] g
         self._rho_0 = -m.porosity * m.rho_f if weight == "change" else (1.0 - m.porosity) * m.rho_s
         whole = 3 * n if local is None else int(local.index.max(initial=-1)) + 1
@@ -185,24 +186,14 @@ class UnsaturatedBiotModel(Stateless):
         self._at = None
         self._forms()
 
-    def _plastic_skeleton(self, rule: NodalIntegration, plasticity: DruckerPrager, weight: str) -> None:
-        """The strain rows, the elastic stabilization alone in ``K`` and the committed history."""
-        if not isinstance(plasticity, DruckerPrager):
-            raise InputError(f"plasticity {plasticity!r} is not a DruckerPrager law")
-        if weight != "full":
-            raise InputError("plasticity needs weight='full': the skeleton's whole stress, from an unstressed start")
-        elastic = self.soil.medium.material.elastic
-        if not np.isclose(plasticity.E, elastic.E) or not np.isclose(plasticity.nu, elastic.nu):
-            raise InputError(f"the plasticity's E = {plasticity.E:g}, nu = {plasticity.nu:g} differ from the medium's "
-                             f"E = {elastic.E:g}, nu = {elastic.nu:g}; give the same elastic constants")
+    def _plastic_skeleton(self, rule: NodalIntegration) -> None:
+        """The strain rows, and the elastic stabilization alone in ``K``."""
         b_test, b_trial = strain_matrix(rule.test), strain_matrix(rule.trial)
         self._b_test = [b_test[c::3].tocsr() for c in range(3)]
         self._b_trial = [b_trial[c::3].tocsr() for c in range(3)]
         smoothed = replace(rule, moments=None, trial_x=None, trial_y=None)
+        elastic = self.soil.medium.material.elastic
         self.K = (self.K - nodal_forms.stiffness(smoothed, elastic.D())).tocsr()  # NSNI's expansion terms alone
-        m = len(rule.weights)
-        self._committed = (np.zeros((m, 3)), np.zeros((m, 4)), np.zeros(m))
-        self._trial = None
 
     def _forms(self) -> None:
         """The patterns of the Jacobian (``tangent``) and of the rate derivatives."""
@@ -276,10 +267,7 @@ class UnsaturatedBiotModel(Stateless):
         lam = self._factor(t)
         r_u = self.K @ u - self.div_test.T @ (lam * V * soil.alpha * c["S"] * pL)
         if self.plasticity is not None:
-            strain, stress, plastic = self._committed
-            eps = np.column_stack([b @ u for b in self._b_trial])
-            self._trial = (eps, self.plasticity.update(stress, eps - strain, plastic))
-            sig = self._trial[1].stress
+            sig = self._return_map(np.column_stack([b @ u for b in self._b_trial]))
             r_u = r_u + sum(b.T @ (V * sig[:, k]) for b, k in zip(self._b_test, (0, 1, 3)))
         body = lam * V * (self._rho_0 + m.porosity * m.rho_f * c["S"])
         r_u[1::2] -= self.NT @ (body * self.g[1])
@@ -299,15 +287,6 @@ class UnsaturatedBiotModel(Stateless):
         r = np.r_[r_u, r_p]
         return r if self._load is None else r - lam * self._load
 
-    def _factor(self, t: float) -> float:
-        """The load factor lambda(t) (1 without a ramp)."""
-        if self.ramp is None:
-            return 1.0
-        lam = float(self.ramp(t))
-        if not np.isfinite(lam):
-            raise InputError(f"ramp({t:g}) = {lam!r}: the load factor must be finite")
-        return lam
-
     def tangent(self, x: np.ndarray, t: float) -> sp.csr_matrix:
         V, soil = self.V, self.soil
         m = soil.medium
@@ -323,10 +302,8 @@ class UnsaturatedBiotModel(Stateless):
         if face is not None:
             w += [self.seepage.weights * self.seepage.penalty * (face > 0.0)]
         if self.plasticity is not None:
-            upd = self._trial[1]
-            d_lambda = np.sqrt(3.0) * (upd.plastic_strain - self._committed[2])
-            ct = self.plasticity.algorithmic_tangent(upd.stress, upd.yielded, d_lambda)
-            w += [V * ct[:, i, j] for i in (0, 1, 3) for j in range(3)]
+            ct = self._return_tangent()
+            w += [V * ct[:, i, j] for i in range(3) for j in range(3)]
         return self._tangent(w)
 
     def rate_force(self, x: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -351,26 +328,3 @@ class UnsaturatedBiotModel(Stateless):
 
     def constraints(self, t: float) -> Constraints:
         return self._constraints
-
-    # ------------------------------------------------------------------ history (plasticity)
-
-    @property
-    def plastic_state(self) -> tuple[np.ndarray, np.ndarray] | None:
-        """With plasticity, the committed sigma'' (num_points, 4) (xx, yy, zz, xy) [Pa] and
-        equivalent plastic strain (num_points,) at the integration points; else ``None``."""
-        return None if self.plasticity is None else self._committed[1:]
-
-    def commit(self) -> None:
-        if self.plasticity is not None and self._trial is not None:
-            eps, upd = self._trial
-            self._committed = (eps, upd.stress, upd.plastic_strain)
-
-    def state(self) -> dict[str, np.ndarray]:
-        if self.plasticity is None:
-            return {}
-        return dict(zip(("strain", "stress", "plastic_strain"), self._committed))
-
-    def restore(self, arrays) -> None:
-        if self.plasticity is not None:
-            self._committed = tuple(np.array(arrays[k]) for k in ("strain", "stress", "plastic_strain"))
-            self._trial = None
