@@ -25,10 +25,13 @@ def _weighted(blocks: np.ndarray, w: np.ndarray) -> sp.csr_matrix:
     return block_diagonal(w[:, None, None] * np.broadcast_to(blocks, (len(w), *blocks.shape[-2:])))
 
 
-def _form(rule: NodalIntegration, matrix_of, metric: np.ndarray) -> sp.csr_matrix:
+def _form(rule: NodalIntegration, matrix_of, metric: np.ndarray, smoothed: bool = True) -> sp.csr_matrix:
     """``T^T W T'`` of the test and trial rows plus the expansion terms, with ``matrix_of`` the
-    point operator of a row set (strains or gradients) and ``metric`` its coefficient."""
-    form = matrix_of(rule.test).T @ _weighted(metric, rule.weights) @ matrix_of(rule.trial)
+    point operator of a row set (strains or gradients) and ``metric`` its coefficient
+    (``smoothed=False``: the expansion terms alone)."""
+    test = matrix_of(rule.test)
+    form = (test.T @ _weighted(metric, rule.weights) @ matrix_of(rule.trial) if smoothed
+            else sp.csr_matrix((test.shape[1],) * 2))
     if rule.moments is not None:
         for j, rows in enumerate((rule.trial_x, rule.trial_y)):
             b = matrix_of(rows)
@@ -39,6 +42,13 @@ def _form(rule: NodalIntegration, matrix_of, metric: np.ndarray) -> sp.csr_matri
 def stiffness(rule: NodalIntegration, d: np.ndarray) -> sp.csr_matrix:
     """Elastic stiffness of the rule, shape ``(2 n, 2 n)``; ``d``: ``(3, 3)`` or ``(n, 3, 3)`` [Pa]."""
     return _form(rule, strain_matrix, np.asarray(d, dtype=float))
+
+
+def stabilization_stiffness(rule: NodalIntegration, d: np.ndarray) -> sp.csr_matrix:
+    """The expansion terms of ``stiffness`` alone (NSNI's sum_L m_Lj B_j^T D B_j; zero without
+    moments), shape ``(2 n, 2 n)``: the elastic stabilization of a skeleton whose smoothed part
+    is nonlinear."""
+    return _form(rule, strain_matrix, np.asarray(d, dtype=float), smoothed=False)
 
 
 def laplacian(rule: NodalIntegration, k=1.0) -> sp.csr_matrix:

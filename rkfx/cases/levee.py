@@ -224,11 +224,12 @@ def _samplers(levee: Levee, nodes: np.ndarray, crest_mid: np.ndarray):
 
 
 def rkpm_levee(p, soil: UnsaturatedSoil, levee: Levee, h: float, rule: str, points: np.ndarray, comm=None,
-               plasticity: DruckerPrager | None = None, ramp=None):
+               plasticity: DruckerPrager | None = None, ramp=None, d=None):
     """The RKPM model of the levee on particles ``p`` and its sampler of [p..., u_x..., u_y...]
     at ``points`` (on ranks: collective, every rank gets all of them); with ``plasticity`` the
-    skeleton is elastic-plastic, its loads scaled by ``ramp(t)``."""
-    d = nodal_discretization(p, h, rule, comm)
+    skeleton is elastic-plastic, its loads scaled by ``ramp(t)``; ``d``: the nodal
+    discretization of an earlier model of the same particles, reused."""
+    d = nodal_discretization(p, h, rule, comm) if d is None else d
     n, x = p.num_nodes, p.x
     size = 3 * n
     base, wet = owned(d, p.boundary_nodes("base")), owned(d, p.boundary_nodes("upstream_wet"))
@@ -408,8 +409,8 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.3, rho_s=2700
                     model, sample, d = rkpm_levee(p, soil, levee, h, rule, points, comm)
                 else:
                     from fem_baselines.gmsh_mesh import mesh_from_gmsh  # noqa: PLC0415
-                    model, sample, fem_strains = fem_levee(mesh_from_gmsh(gmsh.model if rank == 0 else None, comm,
-                                                                          gdim=2), soil, levee, h, points)
+                    mesh_data = mesh_from_gmsh(gmsh.model if rank == 0 else None, comm, gdim=2)
+                    model, sample, fem_strains = fem_levee(mesh_data, soil, levee, h, points)
                 done = steady_state(model, first_step, comm=comm)
             x = done.state.x
             values = sample(x)
@@ -438,10 +439,10 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.3, rho_s=2700
                 dp = DruckerPrager(E=E, nu=nu, phi=phi, c=cohesion)
                 if method == "rkpm":
                     pmodel, psample, _ = rkpm_levee(p, soil, levee, h, rule, points, comm, plasticity=dp,
-                                                    ramp=lambda t: t)
+                                                    ramp=lambda t: t, d=d)
                 else:
-                    pmodel, psample, _ = fem_levee(mesh_from_gmsh(gmsh.model if rank == 0 else None, comm, gdim=2),
-                                                   soil, levee, h, points, plasticity=dp, ramp=lambda t: t)
+                    pmodel, psample, _ = fem_levee(mesh_data, soil, levee, h, points, plasticity=dp,
+                                                   ramp=lambda t: t)
                 stage = plastic_state(pmodel, psample, len(points), x, int(ramp_steps), comm)
                 ramp = stage["ramp"]
                 if method == "rkpm":  # at the nodes (the particles' own points on ranks)

@@ -37,7 +37,7 @@ elastic NSNI expansion terms, sigma'' the return map of each point's committed s
 strain increment, the Jacobian the return's algorithmic tangent; ``ramp`` scales the skeleton's
 loads (gravity) by a factor lambda(t), the path a plastic state is loaded along.
 """
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
@@ -191,9 +191,7 @@ class UnsaturatedBiotModel(PlasticPoints, Stateless):
         b_test, b_trial = strain_matrix(rule.test), strain_matrix(rule.trial)
         self._b_test = [b_test[c::3].tocsr() for c in range(3)]
         self._b_trial = [b_trial[c::3].tocsr() for c in range(3)]
-        smoothed = replace(rule, moments=None, trial_x=None, trial_y=None)
-        elastic = self.soil.medium.material.elastic
-        self.K = (self.K - nodal_forms.stiffness(smoothed, elastic.D())).tocsr()  # NSNI's expansion terms alone
+        self.K = nodal_forms.stabilization_stiffness(rule, self.soil.medium.material.elastic.D())
 
     def _forms(self) -> None:
         """The patterns of the Jacobian (``tangent``) and of the rate derivatives."""
