@@ -131,7 +131,9 @@ class FemUnsaturatedModel(PlasticPoints, FemBiotModel):
         S, dS = self.coef["S"], self.coef["dS"]
         self._lam = lam = const(1.0)
         form = dolfinx.fem.form
-        loads = -lam * alpha * S * p * ufl.div(v) - lam * (rho_0 + n * rho * S) * ufl.inner(g, v)
+        at_one = alpha * S * p * ufl.div(v) + (rho_0 + n * rho * S) * ufl.inner(g, v)
+        self._F_load = form(at_one * dx)  # the skeleton's loads at lambda = 1
+        loads = -lam * at_one
         self._J_up = form(lam * (-alpha * (S + dS * p) * ufl.div(v) - n * rho * dS * ufl.inner(g, v)) *
                           ufl.TrialFunction(self.Q) * dx)
         if self.plasticity is None:
@@ -191,6 +193,15 @@ class FemUnsaturatedModel(PlasticPoints, FemBiotModel):
         loads = self.loads(t).copy()
         loads[:self._n_u] *= lam
         return r - loads
+
+    def load_derivative(self) -> np.ndarray:
+        """dr/dt at the last ``residual`` call: -lambda'(t) times the skeleton's loads at
+        lambda = 1 (weight, pore pressure's force, tractions), as in the RKPM model."""
+        if self.ramp is None:
+            return np.zeros(self.layout.size)
+        t = self._t_trial
+        loads = _global_vector(self._F_load, self.comm) + self.loads(t)[:self._n_u]
+        return -self._factor_slope(t) * np.r_[loads, np.zeros(self.layout.size - self._n_u)]
 
     def tangent(self, x: np.ndarray, t: float) -> sp.csr_matrix:
         kuu = self._kuu

@@ -45,18 +45,26 @@ and rms difference over the interior nodes relative to FEM's largest stress comp
 its mobilized strength sqrt(J_2) / (k_c - a_phi I_1) of Drucker-Prager (1: at yield): where it
 exceeds 1 and where it is largest (at the downstream toe, where the seed's shear band starts).
 
-Stage 1b (``--set plastic=true``, RKPM): the elastic-plastic state in that seepage
+Stage 1b (``--set plastic=true``): the elastic-plastic state in that seepage
 (``plastic_state``). From u = 0 and the steady pressures, gravity (the skeleton's weight, the
 pore pressure's force and the river's traction) rises with a load factor from 0 to 1 in
-``ramp_steps`` backward Euler steps, the effective stress following the Drucker-Prager return
-map (``UnsaturatedBiotModel(..., plasticity=, ramp=)``); reported: the load factor reached
-(a Newton failure after 8 cuts ends the stage there), the crest's settlement against it, the
-equivalent plastic strain and the largest yield function (<= 0: admissible). The FEM baseline
-takes the same law at its quadrature points (``FemUnsaturatedModel(..., plasticity=,
-ramp=)``). With the assumed dimensions the levee holds the river at 0.2 m (both methods within
-5 % of each other) but not at 0.8 m: there the FEM's settlement runs away from lambda = 0.25
-and its Newton fails near 0.4, while RKPM's downstream half flows on, held by its elastic NSNI
-terms alone, its settlement growing as their stiffness falls with h (docs/large_deformation.md).
+``ramp_steps`` static steps (drained: the pressures stay the steady seepage's), the effective
+stress following the Drucker-Prager return map (``UnsaturatedBiotModel(..., plasticity=,
+ramp=)``); reported: the load factor reached (a Newton failure after 8 cuts ends the stage
+there), the crest's settlement against it, the equivalent plastic strain and the largest yield
+function (<= 0: admissible). The FEM baseline takes the same law at its quadrature points
+(``FemUnsaturatedModel(..., plasticity=, ramp=)``).
+
+Stage 1c (``--set collapse=true``, serial): the collapse load (``collapse_path``). From the same
+start the settlement work-conjugate to gravity's loads (their mean settlement) is driven up to
+``settlement_max`` in ``path_steps`` targets and the load factor found in each
+(``rkfx.solvers.path_following``): it rises to the largest gravity the levee carries and
+levels off there, where load control finds no equilibrium. Reported: the path, its peak (the
+collapse load factor), the stiffness left at its end (near 0 on the plateau) and why it ended.
+With the assumed dimensions the collapse load falls from above 1 to about a third of gravity
+as the river rises from 0.4 to 0.8 m, RKPM without the NSNI terms (``rule=snni-vc``) and the
+FEM within a few percent of each other; NSNI's elastic expansion terms harden the mechanism
+(docs/large_deformation.md).
 
 Stage 2, the dynamic collapse from this state on moving particles (``rkfx.models.
 lagrangian_plasticity`` with the u-p flow), is not in this case yet: under NSNI the plastic
@@ -65,9 +73,11 @@ flow of the collapse still goes unstable at the advancing toe (docs/large_deform
 Parameters and units (``--set NAME=VALUE``): E [Pa], nu [-], rho_s, rho_w [kg/m^3], porosity
 [-], conductivity [m/s], K_s, K_w [Pa], gravity [m/s^2], S_rw [-], vg_n [-], vg_beta [1/m],
 phi [deg], cohesion [Pa], height, crest, slope_up, slope_down, water [m], h [m], rule,
-first_step [s], plastic, ramp_steps.
+first_step [s], plastic, ramp_steps, collapse, settlement_max [m], path_steps. The ramp and
+the collapse path keep checkpoints (``--checkpoint-every N`` steps, ``--resume DIR``).
 
     python -m rkfx.cases.levee [--quick] [--method rkpm|fem|both] [--set NAME=VALUE] [--out DIR]
+        [--checkpoint-every N] [--resume DIR]
 """
 import sys
 import time
@@ -93,8 +103,9 @@ from rkfx.models.explicit_poroelasticity import Constituents, collocation_rows
 from rkfx.models.unsaturated_poroelasticity import UnsaturatedBiotModel, UnsaturatedSoil
 from rkfx.report.claims import Claim
 from rkfx.solvers.integrate import integrate
-from rkfx.solvers.model import Constraints
+from rkfx.solvers.model import Constraints, WithoutRates
 from rkfx.solvers.newmark import backward_euler
+from rkfx.solvers.path_following import follow
 from rkfx.solvers.steady import steady_state
 
 NAME = "levee"
@@ -124,6 +135,10 @@ PARAMS = {
     "first_step": Param(0.01, "first pseudo-time step of the steady march [s]"),
     "plastic": Param(False, "RKPM also computes the elastic-plastic state in the steady seepage (stage 1b)"),
     "ramp_steps": Param(20, "steps of the load factor from 0 to 1 in the elastic-plastic stage [-]"),
+    "collapse": Param(False, "with plastic: also follow the mean settlement past the largest gravity the levee "
+                             "carries (serial)"),
+    "settlement_max": Param(0.05, "largest mean settlement (work-conjugate to gravity) of the collapse path [m]"),
+    "path_steps": Param(40, "target settlements of the collapse path, evenly spaced up to settlement_max [-]"),
 }
 QUICK = {"h": 0.1}
 
@@ -147,7 +162,7 @@ def sand(**params) -> UnsaturatedSoil:
 
 def check(*, E, nu, rho_s, rho_w, porosity, conductivity, K_s, K_w, gravity, S_rw, vg_n, vg_beta, phi, cohesion,
           height, crest, slope_up, slope_down, water, h, rule, first_step, plastic=False, ramp_steps=20,
-          **_) -> None:
+          collapse=False, settlement_max=0.05, path_steps=40, **_) -> None:
     """Raise InputError for a parameter outside its documented range (the CLI calls this before any work)."""
     for name, v in (("conductivity", conductivity), ("height", height), ("crest", crest), ("slope_up", slope_up),
                     ("slope_down", slope_down), ("h", h), ("first_step", first_step), ("gravity", gravity)):
@@ -166,6 +181,14 @@ def check(*, E, nu, rho_s, rho_w, porosity, conductivity, K_s, K_w, gravity, S_r
         raise InputError(f"plastic = {plastic!r}: give true or false")
     if int(ramp_steps) != ramp_steps or ramp_steps < 1:
         raise InputError(f"ramp_steps = {ramp_steps!r} must be a whole number >= 1")
+    if not isinstance(collapse, (bool, np.bool_)):
+        raise InputError(f"collapse = {collapse!r}: give true or false")
+    if collapse and not plastic:
+        raise InputError("collapse = true follows the elastic-plastic skeleton: set plastic = true as well")
+    if not (np.isfinite(settlement_max) and settlement_max > 0):
+        raise InputError(f"settlement_max = {settlement_max!r} must be positive [m]")
+    if int(path_steps) != path_steps or path_steps < 1:
+        raise InputError(f"path_steps = {path_steps!r} must be a whole number >= 1")
 
 
 def memory_need(methods, *, height, crest, slope_up, slope_down, h, **_) -> _preflight.Need:
@@ -298,10 +321,11 @@ class _Ramp:
     """The load factor and the crest's settlement of every committed step of the plastic stage."""
 
     def __init__(self, sample, points: int):
-        self.sample, self.points, self.rows = sample, points, []
+        self.sample, self.points, self.rows, self.x = sample, points, [], None
 
     def record(self, s) -> None:
         self.rows.append((s.t, float(-self.sample(s.x)[2 * self.points:][-1])))
+        self.x = s.x
 
     def arrays(self):
         return {"ramp": np.array(self.rows)}
@@ -310,32 +334,80 @@ class _Ramp:
         self.rows = [tuple(r) for r in a["ramp"]]
 
 
-def plastic_state(model, sample, points: int, elastic_x: np.ndarray, steps: int, comm) -> dict:
+def plastic_state(model, sample, points: int, elastic_x: np.ndarray, steps: int, comm, **checkpoints) -> dict:
     """Stage 1b: the skeleton's elastic-plastic equilibrium in the steady seepage of ``elastic_x``.
 
     ``model`` is the method's levee with ``plasticity`` and the load factor ``ramp(t) = t``
     (``rkpm_levee``, ``fem_levee``). From u = 0 and the steady pressures, the skeleton's loads
     (its weight, the pore pressure's force alpha S_w p and the river's traction, i.e. gravity)
     rise from 0 to 1 in ``steps`` backward Euler steps, the stress following the Drucker-Prager
-    return map. A step whose Newton fails is cut (up to 8 times); if it still fails, the stage
-    ends there (a sign, not a proof, that no static equilibrium lies beyond). Returns the
-    lambda reached, the crest's settlement against lambda, and the committed stress and
-    equivalent plastic strain at the model's points (this rank's)."""
+    return map. The steps are static (``WithoutRates``): a drained loading, the pressures those
+    of the steady seepage. A step whose Newton fails is cut (up to 8 times); if it still fails,
+    the stage ends there (a sign, not a proof, that no static equilibrium lies beyond:
+    ``collapse_path`` finds the largest load). Returns the lambda reached, the crest's
+    settlement against lambda, the committed stress and equivalent plastic strain at the
+    model's points (this rank's), and the largest change of the sampled pressures [Pa].
+    ``checkpoints``: ``checkpoint_every``, ``checkpoint_dir``, ``resume`` of ``integrate``."""
     x0 = np.array(elastic_x, float)
     x0[model.layout.block("u")] = 0.0
     stepper = backward_euler()
     ramp = _Ramp(sample, points)
     why = "reached lambda = 1"
+    static = WithoutRates(model)  # drained: the pressures keep the steady seepage, whatever the pseudo-time
     try:
-        run = integrate(stepper, model, np.linspace(0.0, 1.0, steps + 1), start=stepper.start(model, x0),
-                        recorder=ramp, comm=comm, max_cuts=8)
-        newton, cuts = run.newton_iterations, run.cuts
+        run = integrate(stepper, static, np.linspace(0.0, 1.0, steps + 1), start=stepper.start(static, x0),
+                        recorder=ramp, comm=comm, max_cuts=8, **checkpoints)
+        newton, cuts, x = run.newton_iterations, run.cuts, run.state.x
     except SolverError as err:
-        why, newton, cuts = f"stopped: {err}", None, None
+        why, newton, cuts, x = f"stopped: {err}", None, None, (x0 if ramp.x is None else ramp.x)
     stress, plastic = model.plastic_state
     rows = np.array(ramp.rows) if ramp.rows else np.zeros((0, 2))
+    pressures = sample(x)[:points] - sample(x0)[:points]
     return {"lambda_reached": float(rows[-1, 0]) if len(rows) else 0.0, "why": why, "newton_iterations": newton,
-            "cuts": cuts, "ramp": rows, "stress": stress, "plastic_strain": plastic}
+            "cuts": cuts, "ramp": rows, "stress": stress, "plastic_strain": plastic,
+            "pressure_change": float(np.abs(pressures).max())}
+
+
+#: The collapse path ends where the load factor grew less than this over the last doubling of the settlement.
+LEVELLED = 2e-3
+
+
+def collapse_path(model, elastic_x: np.ndarray, settlement_max: float, steps: int, comm, **checkpoints) -> dict:
+    """Stage 1c: gravity's load factor lambda along the path of the levee's mean settlement.
+
+    ``model`` is the method's levee with ``plasticity``, the load factor ``ramp(t) = t`` and
+    its history unstressed. From u = 0 in the steady seepage of ``elastic_x`` (drained: the
+    loads f at lambda = 1 stay fixed), the settlement work-conjugate to them,
+    d = f . u / W with W = f . (0, -1) the levee's weight (a uniform settlement s gives d = s),
+    is driven from 0 to ``settlement_max`` in ``steps`` targets and lambda found in each
+    (``rkfx.solvers.path_following``). For a stable (associated) plastic solid lambda(d) rises
+    to the collapse load and levels off; the path ends early where it has (grown less than
+    ``LEVELLED`` over the last doubling of d). Returns the path (d, lambda), its peak, the
+    line through its second half (slope, and intercept at d = 0: the collapse load less a
+    hardening, e.g. of a stabilization) and that slope over the first step's (the stiffness
+    left: near 0 on a plateau). ``checkpoints``: ``checkpoint_every``,
+    ``checkpoint_dir``, ``resume`` of ``follow``."""
+    x0 = np.array(elastic_x, float)
+    u = model.layout.block("u")
+    x0[u] = 0.0
+    model.residual(x0, 1.0)  # a trial only: the loads at lambda = 1
+    f = -model.load_derivative()
+    down = np.zeros_like(x0)
+    down[u] = np.tile([0.0, -1.0], len(x0[u]) // 2)
+    control = f / float(f @ down)
+
+    def levelled(s, path) -> bool:
+        d, t = path.T
+        return bool(s.d >= 4.0 * d[1] and s.t <= (1.0 + LEVELLED) * np.interp(0.5 * s.d, d, t))
+
+    run = follow(model, control, np.linspace(0.0, settlement_max, steps + 1)[1:], x0, 0.0, until=levelled, comm=comm,
+                 **checkpoints)
+    d, t = run.path.T
+    late = d >= 0.5 * d[-1]
+    slope, intercept = np.polyfit(d[late], t[late], 1) if late.sum() >= 2 else (0.0, float(t[-1]))
+    return {"path": run.path, "lambda_peak": float(t.max()), "lambda_end": float(t[-1]), "settlement_end": float(d[-1]),
+            "slope": float(slope), "stiffness_left": float(slope / ((t[1] - t[0]) / (d[1] - d[0]))) if len(d) > 1 else float("nan"), "intercept": float(intercept), "ended": run.ended, "message": run.message,
+            "steps": run.steps, "cuts": run.cuts, "newton_iterations": run.iterations, "wall_s": run.wall_time_s}
 
 
 def _rkpm_strains(model, x: np.ndarray) -> np.ndarray:
@@ -373,17 +445,23 @@ def _at_nodes(d, values: np.ndarray, comm) -> np.ndarray:
 def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.3, rho_s=2700.0, rho_w=1000.0, porosity=0.46,
         conductivity=5.0e-4, K_s=1.0e22, K_w=1.0e9, gravity=9.806, S_rw=0.0842, vg_n=2.0, vg_beta=0.7, phi=20.0,
         cohesion=300.0, height=1.0, crest=0.5, slope_up=2.0, slope_down=2.0, water=0.8, h=0.05, rule="nsni",
-        first_step=0.01, plastic=False, ramp_steps=20) -> Results:
+        first_step=0.01, plastic=False, ramp_steps=20, collapse=False, settlement_max=0.05, path_steps=40,
+        checkpoint_every=0, work_dir=None, resume=None) -> Results:
     """The initial state by both methods on one triangulation; see the module docstring."""
     prm = dict(E=E, nu=nu, rho_s=rho_s, rho_w=rho_w, porosity=porosity, conductivity=conductivity, K_s=K_s, K_w=K_w,
                gravity=gravity, S_rw=S_rw, vg_n=vg_n, vg_beta=vg_beta, phi=phi, cohesion=cohesion, height=height,
                crest=crest, slope_up=slope_up, slope_down=slope_down, water=water, h=h, rule=rule,
-               first_step=first_step, plastic=plastic, ramp_steps=ramp_steps)
+               first_step=first_step, plastic=plastic, ramp_steps=ramp_steps, collapse=collapse,
+               settlement_max=settlement_max, path_steps=path_steps)
     check(**prm)
     soil = _soil(E, nu, rho_s, rho_w, porosity, conductivity, K_s, K_w, gravity, S_rw, vg_n, vg_beta)
     levee = Levee(height, crest, slope_up, slope_down, water)
     comm = _cli.comm()
     rank = comm.rank if comm is not None else 0
+    ck = _cli.Checkpoints(checkpoint_every, work_dir, resume)
+    if collapse and comm is not None and comm.size > 1:
+        raise InputError(f"collapse = true runs serially (its path's bordered row is global), not on {comm.size} "
+                         "ranks: run it without mpiexec")
     import gmsh  # noqa: PLC0415
 
     from rkfx.geometry.gmsh_nodes import from_gmsh  # noqa: PLC0415
@@ -443,7 +521,9 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.3, rho_s=2700
                 else:
                     pmodel, psample, _ = fem_levee(mesh_data, soil, levee, h, points, plasticity=dp,
                                                    ramp=lambda t: t)
-                stage = plastic_state(pmodel, psample, len(points), x, int(ramp_steps), comm)
+                unstressed = pmodel.state()
+                stage = plastic_state(pmodel, psample, len(points), x, int(ramp_steps), comm,
+                                      **ck.for_run(f"{label}-ramp"))
                 ramp = stage["ramp"]
                 if method == "rkpm":  # at the nodes (the particles' own points on ranks)
                     eps_p, stress_p = _at_nodes(d, stage["plastic_strain"], comm), _at_nodes(d, stage["stress"], comm)
@@ -458,8 +538,17 @@ def run(*, methods: Sequence[str] = ("rkpm", "fem"), E=1.0e7, nu=0.3, rho_s=2700
                             plastic_newton_iterations=stage["newton_iterations"], plastic_cuts=stage["cuts"],
                             plastic_crest_settlement=float(ramp[-1, 1]) if len(ramp) else 0.0,
                             plastic_strain_max=_largest(eps_p, comm), **where,
+                            plastic_pressure_change=stage["pressure_change"],
                             plastic_yield_excess=_largest(dp.yield_function(stress_p), comm) / dp.k_c)
                 series.update(ramp_lambda=ramp[:, 0], ramp_settlement=ramp[:, 1])
+                if collapse:
+                    pmodel.restore(unstressed)
+                    path = collapse_path(pmodel, x, float(settlement_max), int(path_steps), comm,
+                                         **ck.for_run(f"{label}-collapse"))
+                    info.update({f"collapse_{k}": v for k, v in path.items() if k != "path"})
+                    series.update(collapse_settlement=path["path"][:, 0], collapse_lambda=path["path"][:, 1])
+                    if method == "rkpm":  # the mechanism: the plastic strain at the path's end
+                        series.update(collapse_plastic_strain=_at_nodes(d, pmodel.plastic_state[1], comm))
             results.runs.append(Run(label, time.perf_counter() - t0, whole_unknowns(model), series=series, info=info))
         if rank == 0:
             gmsh.model.remove()
@@ -591,21 +680,29 @@ def _plot_plastic(runs: dict, tri, outline, prm, plt, out: Path) -> Path:
 
     r = runs["rkpm"]
     info, s = r.info, r.series
-    fig = plt.figure(figsize=(14, 7.5), layout="constrained")
-    grid = fig.add_gridspec(2, 3, height_ratios=[1.0, 0.9])
+    fig = plt.figure(figsize=(15, 8.5), layout="constrained")
+    grid = fig.add_gridspec(2, 3, height_ratios=[1.0, 1.0], width_ratios=[1.0, 1.0, 1.25])
     a_map, a_ramp = fig.add_subplot(grid[0, :]), fig.add_subplot(grid[1, 0])
     a_map.set_aspect("equal")
     a_map.plot(outline[:, 0], outline[:, 1], color="k", lw=0.8)
-    eps_p = np.maximum(np.asarray(s["plastic_strain"]), 1e-6)
+    at_collapse = "collapse_plastic_strain" in s
+    eps_p = np.maximum(np.asarray(s["collapse_plastic_strain" if at_collapse else "plastic_strain"]), 1e-6)
     top = max(int(np.ceil(np.log10(eps_p.max()))), -5)
     c = a_map.tricontourf(tri, eps_p, levels=np.logspace(-6, top, 4 * (top + 6) + 1), norm=LogNorm(), cmap="inferno")
     a_map.tricontour(tri, np.asarray(s["p"]), levels=[0.0], colors="c", linewidths=1.2)
-    a_map.plot([info["plastic_strain_max_x"]], [info["plastic_strain_max_y"]], "c*", ms=12)
+    if not at_collapse:
+        a_map.plot([info["plastic_strain_max_x"]], [info["plastic_strain_max_y"]], "c*", ms=12)
     fig.colorbar(c, ax=a_map, label="equivalent plastic strain", shrink=0.9, ticks=10.0 ** np.arange(-6, top + 1))
     a_map.set_xlabel("x [m]")
     a_map.set_ylabel("y [m]")
-    a_map.set_title(f"{r.method}, elastic-plastic: equivalent plastic strain (largest {info['plastic_strain_max']:.3g} at "
-                    f"the star; above 1e-3 at {info['plastic_nodes']} nodes), water table (cyan)", fontsize=9)
+    if at_collapse:
+        a_map.set_title(f"{r.method}, the collapse mechanism: equivalent plastic strain at the collapse path's end "
+                        f"(lambda {info['collapse_lambda_end']:.3g}, largest {eps_p.max():.3g}), water table (cyan)",
+                        fontsize=9)
+    else:
+        a_map.set_title(f"{r.method}, elastic-plastic at lambda {info['lambda_reached']:.3g}: equivalent plastic strain "
+                        f"(largest {info['plastic_strain_max']:.3g} at the star; above 1e-3 at {info['plastic_nodes']} "
+                        "nodes), water table (cyan)", fontsize=9)
     for key, run in runs.items():
         if "ramp_lambda" not in run.series:
             continue
@@ -620,21 +717,40 @@ def _plot_plastic(runs: dict, tri, outline, prm, plt, out: Path) -> Path:
     a_ramp.set_ylabel("crest settlement [mm]")
     a_ramp.legend(fontsize=7)
     a_ramp.grid(alpha=0.3)
-    text = fig.add_subplot(grid[1, 1:])
+    collapse = {key: run for key, run in runs.items() if "collapse_lambda" in run.series}
+    if collapse:
+        _plot_collapse(fig.add_subplot(grid[1, 1]), collapse)
+    text = fig.add_subplot(grid[1, 2] if collapse else grid[1, 1:])
     text.set_axis_off()
-    text.text(0.0, 0.95, "\n".join([
-        f"river at {prm['water']:g} m, h = {prm['h']:g} m, {prm['nodes']} nodes, {r.method}",
-        f"steady seepage (elastic march), then gravity raised from 0 to 1 in {prm['ramp_steps']} steps",
-        f"load factor reached: {info['lambda_reached']:.3g} ({info['plastic_why'][:90]})",
-        f"crest settlement {1e3 * info['plastic_crest_settlement']:.3g} mm (elastic {1e3 * info['crest_settlement']:.3g} mm)",
-        f"largest yield function f / k_c = {info['plastic_yield_excess']:.2g} (admissible: <= 0)",
-        *[f"{run.method}: lambda reached {run.info['lambda_reached']:.3g}, crest settlement "
-          f"{1e3 * run.info['plastic_crest_settlement']:.3g} mm, largest plastic strain {run.info['plastic_strain_max']:.3g}"
-          f"{'' if run.info['lambda_reached'] == 1.0 else ' (Newton failed beyond)'}"
-          for key, run in runs.items() if key != "rkpm" and "lambda_reached" in run.info]]), va="top", fontsize=10)
-    fig.suptitle(f"Levee (§6.4.3), stage 1b: the elastic-plastic state in the steady seepage (Drucker-Prager phi "
+    text.text(0.0, 0.98, "\n".join([
+        f"river at {prm['water']:g} m, h = {prm['h']:g} m, {prm['nodes']} nodes",
+        "steady seepage (elastic march), then gravity raised",
+        f"from 0 to 1 in {prm['ramp_steps']} drained steps (load control):",
+        *[f"  {run.method}: lambda reached {run.info['lambda_reached']:.3g}, crest settlement "
+          f"{1e3 * run.info['plastic_crest_settlement']:.3g} mm" for run in runs.values() if "lambda_reached" in run.info],
+        f"  {r.method}: elastic {1e3 * info['crest_settlement']:.3g} mm, largest f / k_c = {info['plastic_yield_excess']:.2g}",
+        *(["collapse path (settlement driven):"] if collapse else []),
+        *[f"  {run.method}: lambda peaks at {run.info['collapse_lambda_peak']:.3g}, stiffness left "
+          f"{run.info['collapse_stiffness_left']:.2g}, ended: {run.info['collapse_ended']}" for run in collapse.values()]]),
+        va="top", fontsize=9)
+    fig.suptitle(f"Levee (§6.4.3), stage 1b{'/1c' if collapse else ''}: the elastic-plastic state in the steady "
+                 f"seepage{' and its collapse load' if collapse else ''} (Drucker-Prager phi "
                  f"{prm['phi']:g} deg, c {prm['cohesion']:g} Pa)")
     return _cli.save(fig, out / "plastic_state.png")
+
+
+def _plot_collapse(ax, runs: dict) -> None:
+    """The collapse paths: gravity's load factor against the crest's mean settlement."""
+    for key, run in runs.items():
+        d, lam = 1e3 * np.asarray(run.series["collapse_settlement"]), np.asarray(run.series["collapse_lambda"])
+        color = "C3" if key == "rkpm" else "k"
+        ax.plot(d, lam, "o-", ms=2, color=color, label=f"{run.method} (peak {lam.max():.3g})")
+    ax.axhline(1.0, color="C0", lw=0.8, ls=":", label="full gravity")
+    ax.set_xlabel("mean settlement (work-conjugate to gravity) [mm]")
+    ax.set_ylabel("load factor lambda (gravity)")
+    ax.set_title("collapse path (settlement driven)", fontsize=9)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
 
 
 CLAIMS = [
@@ -651,7 +767,7 @@ CLAIMS = [
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command-line entry point (see the module docstring)."""
-    return _cli.main(NAME, __doc__, PARAMS, run, plot, argv, QUICK)
+    return _cli.main(NAME, __doc__, PARAMS, run, plot, argv, QUICK, checkpoints=True)
 
 
 if __name__ == "__main__":

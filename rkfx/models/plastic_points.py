@@ -53,6 +53,13 @@ class PlasticPoints:
             raise InputError(f"ramp({t:g}) = {lam!r}: the load factor must be finite")
         return lam
 
+    def _factor_slope(self, t: float) -> float:
+        """lambda'(t) by central differences (exact for a linear ramp; 0 without a ramp)."""
+        if self.ramp is None:
+            return 0.0
+        e = 1e-6 * max(1.0, abs(t))
+        return (self._factor(t + e) - self._factor(t - e)) / (2.0 * e)
+
     def _return_map(self, eps: np.ndarray) -> np.ndarray:
         """The trial stresses (points, 4) of the strains ``eps`` (points, 3), kept as the trial."""
         strain, stress, plastic = self._committed

@@ -263,14 +263,18 @@ class UnsaturatedBiotModel(PlasticPoints, Stateless):
         k = m.k * c["kr"]
         grad = [t @ P for t in self.trial]
         lam = self._factor(t)
-        r_u = self.K @ u - self.div_test.T @ (lam * V * soil.alpha * c["S"] * pL)
+        loads = self.div_test.T @ (V * soil.alpha * c["S"] * pL)  # the skeleton's loads at lambda = 1
+        body = V * (self._rho_0 + m.porosity * m.rho_f * c["S"])
+        loads[1::2] += self.NT @ (body * self.g[1])
+        if self.g[0]:
+            loads[0::2] += self.NT @ (body * self.g[0])
+        if self._load is not None:
+            loads = loads + self._load[:2 * n]
+        r_u = self.K @ u - lam * loads
         if self.plasticity is not None:
             sig = self._return_map(np.column_stack([b @ u for b in self._b_trial]))
             r_u = r_u + sum(b.T @ (V * sig[:, k]) for b, k in zip(self._b_test, (0, 1, 3)))
-        body = lam * V * (self._rho_0 + m.porosity * m.rho_f * c["S"])
-        r_u[1::2] -= self.NT @ (body * self.g[1])
-        if self.g[0]:
-            r_u[0::2] -= self.NT @ (body * self.g[0])
+        self._loads_at = (t, loads)
         r_p = sum(self.test[j].T @ (V * k * (grad[j] - c["S"] * m.rho_f * self.g[j])) for j in range(2))
         second = []
         for mom, rows in self.expansion:
@@ -283,7 +287,15 @@ class UnsaturatedBiotModel(PlasticPoints, Stateless):
             r_p = r_p + self._face.T @ (self.seepage.weights * self.seepage.penalty * np.maximum(face, 0.0))
         self._at = (pL, c, grad, second, face)
         r = np.r_[r_u, r_p]
-        return r if self._load is None else r - lam * self._load
+        return r if self._load is None else r - lam * np.r_[np.zeros(2 * n), self._load[2 * n:]]
+
+    def load_derivative(self) -> np.ndarray:
+        """dr/dt at the last ``residual`` call: -lambda'(t) times the loads at lambda = 1 (the
+        skeleton's weight, the pore pressure's force and ``load``; path following,
+        ``rkfx.solvers.path_following``)."""
+        t, loads = self._loads_at
+        flow = np.zeros(self.n) if self._load is None else self._load[2 * self.n:]
+        return -self._factor_slope(t) * np.r_[loads, flow]
 
     def tangent(self, x: np.ndarray, t: float) -> sp.csr_matrix:
         V, soil = self.V, self.soil

@@ -11,6 +11,7 @@ steppers, one Newton, checkpoints.
     central_difference  central differences with a lumped mass for explicit models:
                    projected essential conditions, prescribed velocities, energies
     quasi_static   load stepping with step cutting and dissipation control (snap-backs)
+    path_following a displacement prescribed and the load factor found: past limit loads
     integrate      the time loop: step cutting, outputs, checkpoints and resume
     checkpoint     atomic checkpoint files
 """

@@ -144,3 +144,26 @@ def equation_weights(model, coefficients) -> np.ndarray | None:
     """
     fn = getattr(model, "equation_weights", None)
     return None if fn is None else fn(coefficients)
+
+
+class WithoutRates:
+    """A model's static equilibria: ``model`` with its rate terms (mass, capacity,
+    ``rate_force``) dropped, everything else its own. A load ramp stepped through this is a
+    sequence of equilibria of the loads alone (a drained loading of a u-p model: its pore
+    pressures keep the steady flow), whatever the ramp's pseudo-time."""
+
+    _dropped = ("rate_force", "rate_tangents")
+
+    def __init__(self, model):
+        self._model = model
+
+    def __getattr__(self, name):
+        if name in WithoutRates._dropped:
+            raise AttributeError(name)
+        return getattr(self._model, name)
+
+    def mass(self) -> None:
+        return None
+
+    def capacity(self, dt: float) -> None:
+        return None

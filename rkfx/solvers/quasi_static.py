@@ -162,17 +162,27 @@ class Marched:
     wall_time_s: float
 
 
-class _ConstraintRows:
-    """G, G^T and the fixed entries of the step Jacobian: -G^T, G, and the column of -rate
-    (whose values are set per call)."""
+class ConstraintRows:
+    """The constraint rows G of a step system over z = (x, mu, lam): G, G^T, and the step
+    Jacobian [[K, -G^T, .], [G, 0, .], [., ., .]] bordered by one row and column (``bordered``).
+    Shared with ``rkfx.solvers.path_following``."""
 
     def __init__(self, G: sp.csr_matrix):
         self.G, self.GT = G, G.T.tocsr()
         gc = G.tocoo()
-        k, n = G.shape
-        self.rows = [gc.col, n + gc.row, n + np.arange(k)]
-        self.cols = [n + gc.row, gc.col, np.full(k, n + k)]
-        self.data = [-gc.data, gc.data]
+        self.k, self.n = G.shape
+        self._rows, self._cols, self._data = [gc.col, self.n + gc.row], [self.n + gc.row, gc.col], [-gc.data, gc.data]
+
+    def bordered(self, K: sp.spmatrix, rows: list, cols: list, data: list) -> sp.csr_matrix:
+        """The step Jacobian of the tangent ``K`` with the further entries (``rows``, ``cols``,
+        ``data``: lists of arrays) in the border (row and column n + k), assembled from
+        triplets (a block matrix of scipy costs more than the factorization of these small
+        systems)."""
+        kc = sp.coo_matrix(K)
+        size = self.n + self.k + 1
+        return sp.csr_matrix((np.concatenate([kc.data, *self._data, *data]),
+                              (np.concatenate([kc.row, *self._rows, *rows]), np.concatenate([kc.col, *self._cols, *cols]))),
+                             shape=(size, size))
 
 
 class _ControlledSystem:
@@ -180,7 +190,7 @@ class _ControlledSystem:
 
     linear = False
 
-    def __init__(self, stepper: QuasiStatic, model: Model, rows: _ConstraintRows, weights, tol: float,
+    def __init__(self, stepper: QuasiStatic, model: Model, rows: ConstraintRows, weights, tol: float,
                  target: float | None = None, tau: float | None = None, lam0: float = 0.0, f0: float = 0.0):
         self.stepper, self.model, self.G, self.GT, self.fixed = stepper, model, rows.G, rows.GT, rows
         self.n, self.k = rows.G.shape[1], rows.G.shape[0]
@@ -204,14 +214,10 @@ class _ControlledSystem:
         return self.rate if self.weights is None else self.weights
 
     def jacobian(self, z):
-        """[[K, -G^T, 0], [G, 0, -rate], [0, c_mu, c_lam]], assembled from triplets (a block
-        matrix of scipy costs more than the factorization of these small systems)."""
+        """[[K, -G^T, 0], [G, 0, -rate], [0, c_mu, c_lam]]."""
         x, _, lam = self.split(z)
-        kc = sp.coo_matrix(self.model.tangent(x, lam))
         n, k = self.n, self.k
-        fx = self.fixed
-        rows, cols = [kc.row, *fx.rows], [kc.col, *fx.cols]
-        data = [kc.data, *fx.data, -np.asarray(self.rate, float)]
+        rows, cols, data = [n + np.arange(k)], [np.full(k, n + k)], [-np.asarray(self.rate, float)]
         if self.tau is None:  # lam - lam_target
             rows += [[n + k]]
             cols += [[n + k]]
@@ -220,8 +226,7 @@ class _ControlledSystem:
             rows += [np.full(k + 1, n + k)]
             cols += [n + np.arange(k + 1)]
             data += [np.r_[-0.5 * self.lam0 * np.asarray(self._weights(), float), 0.5 * self.f0]]
-        return sp.csr_matrix((np.concatenate(data), (np.concatenate(rows), np.concatenate(cols))),
-                             shape=(n + k + 1, n + k + 1))
+        return self.fixed.bordered(self.model.tangent(x, lam), rows, cols, data)
 
     def jacobian_key(self):
         return None
@@ -276,7 +281,7 @@ def march(model: Model, targets, stepper: QuasiStatic = QuasiStatic(), *, record
         raise InputError("quasi-static constraints need rate = dg/dlam (Constraints.rate)")
     G = sp.csr_matrix(con.G)
     n, k = model.layout.size, G.shape[0]
-    constraint_rows = _ConstraintRows(G)
+    constraint_rows = ConstraintRows(G)
     weights = getattr(model, "reaction_weights", None)
     if weights is not None:
         weights = np.asarray(weights, float)
