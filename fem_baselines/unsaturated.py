@@ -96,13 +96,7 @@ class FemUnsaturatedModel(PlasticPoints, FemBiotModel):
         flux = grad_p = ufl.grad(p) - S * rho * g
         form = dolfinx.fem.form
         self.plasticity, self.ramp = plasticity, ramp
-        if plasticity is None and ramp is None:
-            self._F_u = form((ufl.inner(sigma(u), strain(v)) - alpha * S * p * ufl.div(v)
-                              - (rho_0 + n * rho * S) * ufl.inner(g, v)) * dx)
-            self._J_uu = form(ufl.inner(sigma(du), strain(v)) * dx)
-            self._J_up = form((-alpha * (S + dS * p) * dp * ufl.div(v) - n * rho * dS * dp * ufl.inner(g, v)) * dx)
-        else:
-            self._plastic_forms(mesh, cell, quadrature_degree, weight, sigma, dx, const, alpha, n, rho, rho_0, g)
+        self._skeleton_forms(mesh, cell, quadrature_degree, weight, sigma, dx, const, alpha, n, rho, rho_0, g)
         F_p = k * kr * ufl.inner(flux, ufl.grad(q)) * dx
         J_pp = (k * kr * ufl.inner(ufl.grad(dp), ufl.grad(q)) + k * dkr * dp * ufl.inner(grad_p, ufl.grad(q))
                 - k * kr * dS * dp * rho * ufl.inner(g, ufl.grad(q))) * dx
@@ -124,9 +118,10 @@ class FemUnsaturatedModel(PlasticPoints, FemBiotModel):
         self._kuu = _global_matrix(self._J_uu, self.comm) if self.plasticity is None else None
         self._q = [form(-k * kr * flux[j] * dx) for j in range(2)]
 
-    def _plastic_forms(self, mesh, cell, degree, weight, sigma, dx, const, alpha, n, rho, rho_0, g) -> None:
-        """F_u and its Jacobian with a load factor, and with plasticity the stress and tangent
-        held on quadrature spaces (Voigt: strain (xx, yy, gamma_xy), stress (xx, yy, xy))."""
+    def _skeleton_forms(self, mesh, cell, degree, weight, sigma, dx, const, alpha, n, rho, rho_0, g) -> None:
+        """F_u and its Jacobian with the load factor (1 without a ramp), and with plasticity the
+        stress and tangent held on quadrature spaces (Voigt: strain (xx, yy, gamma_xy), stress
+        (xx, yy, xy))."""
         u, v, du, p = self.uh, ufl.TestFunction(self.V), ufl.TrialFunction(self.V), self.ph
         S, dS = self.coef["S"], self.coef["dS"]
         self._lam = lam = const(1.0)
@@ -180,9 +175,6 @@ class FemUnsaturatedModel(PlasticPoints, FemBiotModel):
     def residual(self, x: np.ndarray, t: float) -> np.ndarray:
         self._set(x)
         self._t_trial = t
-        if self.plasticity is None and self.ramp is None:
-            r = np.r_[_global_vector(self._F_u, self.comm), _global_vector(self._F_p, self.comm)]
-            return r - self.loads(t)
         lam = self._factor(t)
         self._lam.value = lam
         if self.plasticity is not None:
